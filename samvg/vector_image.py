@@ -277,8 +277,10 @@ def _read_children(
         label = f"{element_path}/{name}[{counts[name]}]"
         if child.get("id"):
             label += f" (id={child.get('id')!r})"
-        if name in _PASS_THROUGH_TAGS or not isinstance(child.tag, str):
+        if not isinstance(child.tag, str) or name in _PASS_THROUGH_TAGS:
             continue
+        if child.tag.startswith("{") and not child.tag.startswith("{" + SVG_NAMESPACE + "}"):
+            continue  # editor metadata in a foreign namespace (e.g. Inkscape's namedview)
         attributes = _style_attributes(child)
         for unsupported in _UNSUPPORTED_ATTRIBUTES:
             if unsupported in attributes:

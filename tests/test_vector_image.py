@@ -1,0 +1,160 @@
+"""Tests of the scene model: SVG parsing, writing, round trips, errors for what it cannot hold."""
+
+import re
+
+import numpy as np
+import pytest
+
+from samvg import InputError, VectorImage, VectorPath
+
+
+def random_image(seed: int, paths: int = 5, segments: int = 4) -> VectorImage:
+    rng = np.random.default_rng(seed)
+    shapes = [
+        VectorPath(rng.uniform(-10, 70, size=(3 * segments, 2)), tuple(rng.uniform(0, 1, 4)))
+        for _ in range(paths)
+    ]
+    return VectorImage(64, 48, shapes, background=(0.2, 0.4, 0.6))
+
+
+def test_round_trip_keeps_geometry_colours_and_background():
+    image = random_image(0)
+    again = VectorImage.from_svg(image.to_svg(precision=6))
+    assert (again.width, again.height) == (64, 48)
+    assert again.background == pytest.approx((51 / 255, 102 / 255, 153 / 255))
+    assert len(again.paths) == len(image.paths)
+    for before, after in zip(image.paths, again.paths, strict=True):
+        np.testing.assert_allclose(after.points, before.points, atol=1e-6)
+        np.testing.assert_allclose(after.fill[:3], before.fill[:3], atol=0.5 / 255)
+        assert after.fill[3] == pytest.approx(before.fill[3], abs=5e-4)
+
+
+def test_precision_rounds_coordinates():
+    image = VectorImage(10, 10, [VectorPath(np.array([[1.23456, 2.5], [3, 4], [5, 6.789]]))])
+    text = image.to_svg(precision=2)
+    assert 'd="M1.23 2.5C3 4 5 6.79 1.23 2.5Z"' in text
+    assert 'width="10" height="10" viewBox="0 0 10 10"' in text
+
+
+def test_relative_and_absolute_commands_agree():
+    absolute = (
+        '<svg xmlns="http://www.w3.org/2000/svg" width="20" height="20">'
+        '<path d="M2 2 L10 2 C12 4 12 8 10 10 H2 V2 Z" fill="rgb(255,0,0)"/></svg>'
+    )
+    relative = (
+        '<svg xmlns="http://www.w3.org/2000/svg" width="20" height="20">'
+        '<path d="m2 2 l8 0 c2 2 2 6 0 8 h-8 v-8 z" fill="#f00"/></svg>'
+    )
+    first, second = VectorImage.from_svg(absolute), VectorImage.from_svg(relative)
+    np.testing.assert_allclose(first.paths[0].points, second.paths[0].points)
+    assert first.paths[0].fill == second.paths[0].fill == (1.0, 0.0, 0.0, 1.0)
+    # L becomes a straight cubic with controls at thirds; 4 segments, closing one implicit.
+    points = first.paths[0].points
+    assert points.shape == (12, 2)
+    np.testing.assert_allclose(points[:3], [[2, 2], [2 + 8 / 3, 2], [2 + 16 / 3, 2]])
+
+
+def test_unclosed_path_gets_a_closing_line_and_quadratic_is_exact_cubic():
+    svg = (
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 30 30">'
+        '<path d="M0 0 Q 15 30 30 0" fill="blue" fill-opacity="0.5"/></svg>'
+    )
+    path = VectorImage.from_svg(svg).paths[0]
+    np.testing.assert_allclose(path.points[:3], [[0, 0], [10, 20], [20, 20]])
+    assert path.num_segments == 2
+    assert path.fill == (0.0, 0.0, 1.0, 0.5)
+
+
+def test_viewbox_scales_to_pixel_canvas():
+    svg = (
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100" height="50" viewBox="10 0 20 10">'
+        '<rect x="10" y="0" width="20" height="10" fill="#ffffff"/>'
+        '<path d="M10 0 L30 10 L10 10 Z"/></svg>'
+    )
+    image = VectorImage.from_svg(svg)
+    assert (image.width, image.height) == (100, 50)
+    assert image.background == (1.0, 1.0, 1.0)
+    np.testing.assert_allclose(image.paths[0].points[[0, 3, 6]], [[0, 0], [100, 50], [0, 50]])
+
+
+def test_partial_rect_becomes_a_path():
+    svg = (
+        '<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">'
+        '<rect x="2" y="3" width="4" height="5" fill="#000"/></svg>'
+    )
+    image = VectorImage.from_svg(svg)
+    assert image.background is None
+    np.testing.assert_allclose(
+        image.paths[0].points[[0, 3, 6, 9]], [[2, 3], [6, 3], [6, 8], [2, 8]]
+    )
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        ('<path d="M0 0 A 5 5 0 0 1 10 10 Z"/>', "arc"),
+        ('<path d="M0 0 L5 5 L0 5 Z M6 6 L8 8 L6 8 Z"/>', "several subpaths"),
+        ('<path id="p1" d="M0 0 L5 5 L0 5 Z" transform="scale(2)"/>', "path[1] (id='p1')"),
+        ('<circle cx="5" cy="5" r="3"/>', "<circle>"),
+        ('<path d="M0 0 L5 5 L0 5 Z" fill="url(#g)"/>', "only solid fills"),
+        ('<path d="M0 0 L5 5 L0 5 Z" fill="notacolour"/>', "fill colour"),
+        ('<path d="M0 0 L5 5 L0 5 Z" stroke="#000"/>', "strokes"),
+        ('<path d="M0 0 L5 Z"/>', "needs 2 numbers"),
+        ('<path d="L5 5"/>', "must start with M"),
+    ],
+)
+def test_unrepresentable_svg_is_a_clear_error(body, message):
+    svg = f'<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">{body}</svg>'
+    with pytest.raises(InputError, match=re.escape(message)):
+        VectorImage.from_svg(svg)
+
+
+def test_not_xml_and_not_svg_are_clear_errors():
+    with pytest.raises(InputError, match="not valid SVG"):
+        VectorImage.from_svg("<svg")
+    with pytest.raises(InputError, match="expected <svg>"):
+        VectorImage.from_svg("<html/>")
+
+
+def test_invalid_paths_and_canvas_are_rejected():
+    with pytest.raises(InputError, match=r"\(3K, 2\)"):
+        VectorPath(np.zeros((4, 2)))
+    with pytest.raises(InputError, match="RGBA"):
+        VectorPath(np.zeros((3, 2)), (2.0, 0, 0, 1))
+    with pytest.raises(InputError, match="width"):
+        VectorImage(0, 10)
+
+
+def test_stacked_paths_pad_with_zero_length_segments():
+    image = VectorImage(
+        10,
+        10,
+        [VectorPath(np.arange(6.0).reshape(3, 2)), VectorPath(np.arange(12.0).reshape(6, 2))],
+    )
+    points, colours = image.stacked_paths()
+    assert points.shape == (2, 6, 2) and colours.shape == (2, 4)
+    np.testing.assert_allclose(points[0, :3], [[0, 1]] * 3)
+    np.testing.assert_allclose(points[0, 3:], image.paths[0].points)
+
+
+def test_save_is_atomic(tmp_path, monkeypatch):
+    target = tmp_path / "out.svg"
+    target.write_text("old")
+    image = random_image(1)
+
+    def failing_replace(*_args):
+        raise OSError("disk full")
+
+    monkeypatch.setattr("os.replace", failing_replace)
+    with pytest.raises(OSError, match="disk full"):
+        image.save(target)
+    assert target.read_text() == "old"
+    assert list(tmp_path.iterdir()) == [target]
+    monkeypatch.undo()
+    image.save(target)
+    assert VectorImage.load(target).to_svg() == image.to_svg()
+
+
+def test_load_missing_file_is_a_clear_error(tmp_path):
+    with pytest.raises(InputError, match="not found"):
+        VectorImage.load(tmp_path / "missing.svg")
