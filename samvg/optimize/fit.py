@@ -1,0 +1,70 @@
+"""Adam on control points and fill colours against the pixel MSE to the target image, through the
+differentiable rasterizer.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from samvg.errors import InputError
+from samvg.render import rasterize
+
+
+@dataclass
+class FitResult:
+    """Optimised ``points`` (P, 3K, 2), ``colours`` (P, 4) and the MSE after each step."""
+
+    points: np.ndarray
+    colours: np.ndarray
+    losses: list[float]
+
+
+def fit_paths(
+    points: np.ndarray,
+    colours: np.ndarray,
+    target: np.ndarray,
+    steps: int = 100,
+    point_learning_rate: float = 0.5,
+    colour_learning_rate: float = 0.01,
+    background: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    on_step: Callable[[int, float], None] | None = None,
+) -> FitResult:
+    """Fit paths to ``target`` (H, W, 3) float in [0, 1] for ``steps`` Adam steps.
+
+    ``on_step(step, loss)`` is called after every step (progress reporting).
+    """
+    target_array = np.asarray(target, dtype=np.float32)
+    if target_array.ndim != 3 or target_array.shape[2] != 3:
+        raise InputError(f"target must be an (H, W, 3) image, got shape {target_array.shape}")
+    height, width = target_array.shape[:2]
+    target_tensor = torch.from_numpy(np.ascontiguousarray(target_array))
+    point_tensor = torch.tensor(points, dtype=torch.float32, requires_grad=True)
+    colour_tensor = torch.tensor(colours, dtype=torch.float32, requires_grad=True)
+    losses: list[float] = []
+    if steps > 0 and len(point_tensor) > 0:
+        optimizer = torch.optim.Adam(
+            [
+                {"params": [point_tensor], "lr": point_learning_rate},
+                {"params": [colour_tensor], "lr": colour_learning_rate},
+            ]
+        )
+        for step in range(steps):
+            optimizer.zero_grad(set_to_none=True)
+            rendered = rasterize(point_tensor, colour_tensor, width, height, background=background)
+            loss = torch.mean((rendered - target_tensor) ** 2)
+            loss.backward()
+            optimizer.step()
+            with torch.no_grad():
+                colour_tensor.clamp_(0.0, 1.0)
+            losses.append(float(loss))
+            if on_step is not None:
+                on_step(step, losses[-1])
+    return FitResult(
+        points=point_tensor.detach().numpy().astype(np.float64),
+        colours=colour_tensor.detach().numpy().astype(np.float64),
+        losses=losses,
+    )
