@@ -57,7 +57,7 @@ def _vectorize(arguments: argparse.Namespace, console) -> None:  # type: ignore[
     with progress:
         result = vectorize(image, config, progress=report)
     result.save(arguments.output, precision=arguments.precision)
-    console.print(f"wrote {arguments.output} ({len(result.paths)} paths)")
+    console.print(f"wrote {arguments.output} ({len(result.paths)} paths)", markup=False)
     if arguments.preview is not None:
         write_png(arguments.preview, result.render())
         console.print(f"wrote {arguments.preview}")
@@ -125,13 +125,14 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 error, 130 interrupted)."""
     from rich.console import Console
+    from rich.markup import escape
 
     arguments = build_parser().parse_args(argv)
     console = Console(stderr=True)
     try:
         arguments.handler(arguments, console)
     except SamvgError as error:
-        console.print(f"[bold red]error:[/] {error}", highlight=False)
+        console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False)
         return 1
     except KeyboardInterrupt:
         console.print("interrupted")

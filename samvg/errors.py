@@ -1,4 +1,4 @@
-"""Exception types that samvg raises for expected user mistakes (the CLI prints them without a traceback)."""
+"""Exception types for expected user mistakes (the CLI prints them without a traceback)."""
 
 
 class SamvgError(Exception):
