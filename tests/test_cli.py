@@ -1,0 +1,102 @@
+"""Tests of the command line: real runs, plain one-line errors, no half-written outputs."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from samvg import VectorImage
+from samvg.cli import main
+from samvg.io import read_image
+
+SAMPLE = Path(__file__).resolve().parents[1] / "samvg" / "samples" / "sailing_sunset.png"
+
+
+def test_render_writes_png(tmp_path):
+    svg = tmp_path / "a.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="20" height="10">'
+        '<rect width="20" height="10" fill="#00ff00"/>'
+        '<path d="M0 0 H10 V10 H0 Z" fill="red"/></svg>'
+    )
+    assert main(["render", str(svg), "-o", str(tmp_path / "a.png"), "--scale", "2"]) == 0
+    pixels = read_image(tmp_path / "a.png")
+    assert pixels.shape == (20, 40, 3)
+    assert tuple(pixels[5, 5]) == (255, 0, 0) and tuple(pixels[5, 35]) == (0, 255, 0)
+
+
+def test_bad_svg_is_one_line_error_and_no_output(tmp_path, capsys):
+    svg = tmp_path / "bad.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="9" height="9"><circle r="3"/></svg>'
+    )
+    assert main(["render", str(svg), "-o", str(tmp_path / "bad.png")]) == 1
+    error = capsys.readouterr().err
+    assert "error:" in error and "svg/circle[1]" in error and "Traceback" not in error
+    assert not (tmp_path / "bad.png").exists()
+
+
+def test_corrupt_image_is_a_clear_error(tmp_path, capsys):
+    broken = tmp_path / "broken.png"
+    broken.write_bytes(b"\x89PNG\r\n\x1a\n garbage")
+    assert main(["vectorize", str(broken), "-o", str(tmp_path / "out.svg")]) == 1
+    assert "cannot read image" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.png"]
+
+
+def test_wrong_output_suffix_and_missing_folder(tmp_path, capsys):
+    assert main(["vectorize", str(SAMPLE), "-o", str(tmp_path / "out.png")]) == 1
+    assert main(["vectorize", str(SAMPLE), "-o", str(tmp_path / "no" / "out.svg")]) == 1
+    err = capsys.readouterr().err
+    assert "should end in .svg" in err and "does not exist" in err
+
+
+def test_missing_checkpoint_is_a_clear_error(tmp_path):
+    completed = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "samvg.cli",
+            "vectorize",
+            str(SAMPLE),
+            "-o",
+            str(tmp_path / "o.svg"),
+            "--checkpoint",
+            str(tmp_path / "nowhere.pt"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert completed.returncode == 1
+    assert "nowhere.pt" in completed.stderr and "Traceback" not in completed.stderr
+    assert not (tmp_path / "o.svg").exists()
+
+
+@pytest.mark.slow
+def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
+    output, preview = tmp_path / "sample.svg", tmp_path / "sample.png"
+    code = main(
+        [
+            "vectorize",
+            str(SAMPLE),
+            "-o",
+            str(output),
+            "--preview",
+            str(preview),
+            "--checkpoint",
+            str(sam_checkpoint),
+            "--steps",
+            "30",
+        ]
+    )
+    assert code == 0
+    result = VectorImage.load(output)
+    target = read_image(SAMPLE).astype(np.float32) / 255.0
+    assert (result.width, result.height) == (512, 280)
+    assert 5 <= len(result.paths) <= 64
+    mse = float(np.mean((result.render() - target) ** 2))
+    assert mse < 0.01, mse
+    assert read_image(preview).shape == target.shape
