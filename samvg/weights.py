@@ -106,12 +106,11 @@ def verify_file(spec: WeightSpec, path: str | os.PathLike[str]) -> None:
             raise WeightsError(f"{spec.name}: {p} has sha256 {digest}, expected {spec.sha256}")
 
 
-def _progress_copy(
-    src, dst, total: int | None, label: str, progress: bool, hasher=None
-) -> int:
+def _progress_copy(src, dst, total: int | None, label: str, progress: bool, hasher=None) -> int:
     """Copy a binary stream to another, updating a rich progress bar and an optional hasher."""
     n = 0
     if progress:
+        from rich.console import Console
         from rich.progress import (
             BarColumn,
             DownloadColumn,
@@ -120,7 +119,6 @@ def _progress_copy(
             TimeRemainingColumn,
             TransferSpeedColumn,
         )
-        from rich.console import Console
 
         bar = Progress(
             TextColumn("{task.description}"),
@@ -176,19 +174,18 @@ def _extract_member(archive: Path, member: str, dst_path: Path) -> str:
                 _progress_copy(src, out, None, "", False, h)
         return h.hexdigest()
     try:
-        tf = tarfile.open(archive, "r:*")
+        with tarfile.open(archive, "r:*") as tf:
+            try:
+                info = tf.getmember(member)
+            except KeyError:
+                raise OSError(f"archive has no member {member!r}") from None
+            src = tf.extractfile(info)
+            if src is None:
+                raise OSError(f"archive member {member!r} is not a regular file")
+            with src, open(dst_path, "wb") as out:
+                _progress_copy(src, out, None, "", False, h)
     except tarfile.TarError as e:
-        raise OSError(f"not a tar or zip archive: {e}") from None
-    with tf:
-        try:
-            info = tf.getmember(member)
-        except KeyError:
-            raise OSError(f"archive has no member {member!r}") from None
-        src = tf.extractfile(info)
-        if src is None:
-            raise OSError(f"archive member {member!r} is not a regular file")
-        with src, open(dst_path, "wb") as out:
-            _progress_copy(src, out, None, "", False, h)
+        raise OSError(f"not a valid tar or zip archive: {e}") from None
     return h.hexdigest()
 
 

@@ -1,36 +1,45 @@
 """Numba kernels of the exact-area differentiable rasterizer (forward and backward).
 
 Why by hand: no maintained library computes exact box-filtered path coverage *and* its analytic
-gradient on the CPU. diffvg estimates the boundary gradient with random edge samples (and is a C++/
-CUDA build), pydiffvg-style soft rasterizers blur the image, and real renderers (resvg, Skia, Cairo)
-are not differentiable. So the kernels below are written here, in numba (wheels only, no compiler).
+gradient on the CPU. diffvg estimates the boundary gradient from random edge samples (and needs a
+C++/CUDA build), soft rasterizers blur the image, and real renderers (resvg, Skia, Cairo) are not
+differentiable. So the kernels are written here, in numba (installs from wheels, no compiler).
 
 Pipeline (all geometry in float64, pixel units, pixel (r, c) is the square [c, c+1] x [r, r+1]):
 
 1. ``plan_and_flatten``: each cubic segment is cut into ``n`` uniform pieces, ``n`` chosen from the
    second differences of its control polygon so the chord error is <= ``tol``. For a fixed ``n`` the
-   polyline vertices are a linear map (Bernstein weights) of the control points, so the backward
-   pass chains through it exactly (``flatten_backward``).
+   polyline vertices are a linear map (Bernstein weights; evaluated by de Casteljau so straight,
+   axis-aligned segments stay exactly axis-aligned) of the control points, so the backward pass
+   chains through it exactly (``flatten_backward``).
 2. ``path_boxes``: per path, the bounding box of its polyline clipped to the canvas, widened by one
    pixel up and left (the backward pass of grid-aligned edges reads the neighbour pixel) and one
-   spill column on the right. Each box gets a slice of one flat float64 buffer.
-3. ``coverage``: signed-area accumulation (font-rs / stb_truetype v2 technique). Every line piece
-   inside a pixel deposits ``h * (c + 1 - x_mid)`` in its cell and ``h * (x_mid - c)`` in the next
-   one (``h`` = signed height), so the prefix sum along a row is the winding-weighted area of each
-   pixel. Pieces left of the canvas deposit their full height in column 0 (everything right of them
-   is covered), pieces right of the canvas or above/below it deposit nothing. Coverage under the
-   nonzero rule is ``min(1, |acc|)``. Parallel over paths.
-4. ``composite``: straight-alpha "over" in paint order, ``out = out * (1 - a cov) + rgb * a cov``,
-   parallel over rows; optionally keeps the colour under each path for the backward pass.
+   spill column on the right. Each box gets a slice of one flat buffer.
+3. ``render_forward``, per path in paint order: signed-area accumulation (the font-rs /
+   stb_truetype v2 technique). Every line piece inside a pixel deposits ``h * (c + 1 - x_mid)`` in
+   its cell and ``h * (x_mid - c)`` in the next one (``h`` = signed height), so the prefix sum
+   along a row is the winding-weighted area ``acc`` of each pixel. Pieces left of the canvas
+   deposit their full height in column 0 (everything right of them is covered), pieces right of
+   the canvas or above/below it deposit nothing. Nonzero-rule coverage is ``min(1, |acc|)``, and
+   the path is composited at once with straight-alpha "over":
+   ``out = out * (1 - a cov) + rgb * a cov``. For the backward pass ``acc`` and the colour under
+   the path are kept per box pixel (20 bytes per box pixel); a no-grad call keeps nothing.
 
-Backward: ``composite_backward`` walks the paths in reverse and writes dL/dcov per box pixel and
-the colour gradients. ``edge_backward`` then computes dL/d(vertex) as the exact boundary integral:
-the coverage of a pixel only changes where an edge crosses it, and with ``F'(x) = -dL/dacc`` of the
-pixel under the edge, an edge a->b gets ``(1 - s) * F' * (dy, -dx)`` on ``a`` and ``s * F' * (dy, -dx)``
-on ``b``, integrated over the parameter ``s`` of each piece. Endpoint terms cancel between
-consecutive edges of a closed path. Axis-aligned edges lying exactly on pixel grid lines use the
-average of the left and right one-sided derivatives (otherwise the kink of ``min(1, |acc|)`` would
-give them a zero gradient).
+Backward (``render_backward``), per path in reverse paint order: dL/dcov of every box pixel and
+the colour gradients from the compositing, then the exact boundary integral for the vertices:
+the coverage of a pixel only changes where an edge crosses it, and with ``F'(x) = -dL/dacc`` of
+the pixel under the edge, an edge a->b gets ``(1 - s) F' (dy, -dx)`` on ``a`` and
+``s F' (dy, -dx)`` on ``b``, integrated over the parameter ``s`` of each piece (exactly: ``F'``
+is constant per pixel). Endpoint terms cancel between consecutive edges of a closed path.
+Axis-aligned edges lying exactly on pixel grid lines use the average of the left and right
+one-sided derivatives (otherwise the kink of ``min(1, |acc|)`` would give them a zero gradient).
+Work is O(sum of path box areas + number of edge/pixel crossings), never paths x canvas.
+
+Limits: ``min(1, |acc|)`` is the exact nonzero-rule area except in pixels where regions of
+different winding numbers meet (a self-intersection inside the pixel); there it approximates, like
+font rasterizers do. The kernels are single-threaded on purpose: on the 2-core target machine the
+numba OpenMP/workqueue layers cost more in wake-up latency (and fight torch's own threads) than the
+~1 ms of work per call they would split.
 """
 
 from __future__ import annotations
@@ -188,10 +197,11 @@ def path_boxes(verts, path_vstart, width, height):
                 miny = min(miny, y)
                 maxy = max(maxy, y)
             if maxx >= 0.0 and minx <= width and maxy >= 0.0 and miny <= height:
-                bx0 = max(0, int(math.floor(minx)) - 1)
-                by0 = max(0, int(math.floor(miny)) - 1)
-                bx1 = min(width, int(math.floor(maxx)) + 1)
-                by1 = min(height, int(math.floor(maxy)) + 1)
+                # Clamp before converting: huge coordinates must not overflow int64.
+                bx0 = max(0, int(math.floor(max(minx, 0.0))) - 1)
+                by0 = max(0, int(math.floor(max(miny, 0.0))) - 1)
+                bx1 = min(width, int(math.floor(min(maxx, float(width)))) + 1)
+                by1 = min(height, int(math.floor(min(maxy, float(height)))) + 1)
                 if bx1 > bx0 and by1 > by0:
                     box[p, 0] = bx0
                     box[p, 1] = by0
@@ -266,7 +276,8 @@ def _edge_deposit(x0, y0, x1, y1, bw, bh, acc, off, stride):
 
 
 @njit(cache=True, nogil=True)
-def _path_coverage(verts, v0, v1, bx0, by0, bw, bh, acc, off):
+def _path_deposits(verts, v0, v1, bx0, by0, bw, bh, acc, off):
+    """Zero the box buffer of one path and deposit all its edges (before the row prefix sums)."""
     stride = bw + 1
     for i in range(off, off + bh * stride):
         acc[i] = 0.0
@@ -274,126 +285,72 @@ def _path_coverage(verts, v0, v1, bx0, by0, bw, bh, acc, off):
     for e in range(n):
         j = v0 + e + 1 if e + 1 < n else v0
         _edge_deposit(
-            verts[v0 + e, 0] - bx0, verts[v0 + e, 1] - by0,
-            verts[j, 0] - bx0, verts[j, 1] - by0,
-            bw, bh, acc, off, stride,
+            verts[v0 + e, 0] - bx0,
+            verts[v0 + e, 1] - by0,
+            verts[j, 0] - bx0,
+            verts[j, 1] - by0,
+            bw,
+            bh,
+            acc,
+            off,
+            stride,
         )
-    for r in range(bh):
-        base = off + r * stride
-        s = 0.0
-        for c in range(stride):
-            s += acc[base + c]
-            acc[base + c] = s
 
 
 @njit(cache=True, nogil=True)
-def coverage(verts, path_vstart, box, off, acc):
-    """Fill ``acc`` with the winding-weighted area of every box pixel."""
-    n_paths = box.shape[0]
-    for p in range(n_paths):
-        if box[p, 2] > 0 and box[p, 3] > 0:
-            _path_coverage(
-                verts, path_vstart[p], path_vstart[p + 1],
-                box[p, 0], box[p, 1], box[p, 2], box[p, 3], acc, off[p],
-            )
+def render_forward(verts, path_vstart, box, off, colors, background, canvas, acc, under, keep):
+    """Coverage and straight-alpha "over" compositing, path by path in paint order.
 
-
-@njit(cache=True, nogil=True)
-def composite(acc, box, off, colors, background, canvas, under, keep_under):
-    """Straight-alpha over in paint order into ``canvas`` (H, W, 3), float32 or float64."""
+    ``canvas`` (H, W, 3, float32 or float64) receives the image. With ``keep`` the winding-area
+    of every box pixel stays in ``acc`` at ``off[p]`` and the colour under it in ``under`` (for the
+    backward pass); without, ``acc`` is a scratch buffer of the largest box and ``under`` unused.
+    """
     height = canvas.shape[0]
     width = canvas.shape[1]
-    n_paths = box.shape[0]
     for y in range(height):
         for x in range(width):
             for ch in range(3):
                 canvas[y, x, ch] = background[ch]
-        for p in range(n_paths):
-            by0 = box[p, 1]
-            bh = box[p, 3]
-            if y < by0 or y >= by0 + bh:
-                continue
-            bx0 = box[p, 0]
-            bw = box[p, 2]
-            a = colors[p, 3]
-            cr = colors[p, 0]
-            cg = colors[p, 1]
-            cb = colors[p, 2]
-            base = off[p] + (y - by0) * (bw + 1)
+    n_paths = box.shape[0]
+    for p in range(n_paths):
+        bw = box[p, 2]
+        bh = box[p, 3]
+        if bw <= 0 or bh <= 0:
+            continue
+        bx0 = box[p, 0]
+        by0 = box[p, 1]
+        o = off[p] if keep else 0
+        _path_deposits(verts, path_vstart[p], path_vstart[p + 1], bx0, by0, bw, bh, acc, o)
+        a = colors[p, 3]
+        cr = colors[p, 0]
+        cg = colors[p, 1]
+        cb = colors[p, 2]
+        stride = bw + 1
+        for r in range(bh):
+            y = by0 + r
+            base = o + r * stride
+            wind = 0.0
             for c in range(bw):
-                x = bx0 + c
                 k = base + c
-                if keep_under:
+                wind += acc[k]
+                acc[k] = wind
+                x = bx0 + c
+                if keep:
                     under[k, 0] = canvas[y, x, 0]
                     under[k, 1] = canvas[y, x, 1]
                     under[k, 2] = canvas[y, x, 2]
-                cov = min(1.0, abs(acc[k]))
+                cov = min(1.0, abs(wind))
                 if cov > 0.0:
                     ac = a * cov
-                    keep = 1.0 - ac
-                    canvas[y, x, 0] = canvas[y, x, 0] * keep + cr * ac
-                    canvas[y, x, 1] = canvas[y, x, 1] * keep + cg * ac
-                    canvas[y, x, 2] = canvas[y, x, 2] * keep + cb * ac
+                    keep_c = 1.0 - ac
+                    canvas[y, x, 0] = canvas[y, x, 0] * keep_c + cr * ac
+                    canvas[y, x, 1] = canvas[y, x, 1] * keep_c + cg * ac
+                    canvas[y, x, 2] = canvas[y, x, 2] * keep_c + cb * ac
 
 
 # --------------------------------------------------------------------------------------------
 # Backward
 # --------------------------------------------------------------------------------------------
-
-
-@njit(cache=True, nogil=True)
-def composite_backward(grad_out, acc, under, box, off, colors):
-    """Reverse of ``composite``: dL/dcov per box pixel and dL/dcolour (P, 4).
-
-    ``grad_out`` (H, W, 3) is consumed (overwritten) as the running gradient of the canvas.
-    """
-    height = grad_out.shape[0]
-    n_paths = box.shape[0]
-    dcov = np.zeros(acc.shape[0], np.float64)
-    gcol = np.zeros((n_paths, 4), np.float64)
-    for y in range(height):
-        for p in range(n_paths - 1, -1, -1):
-            by0 = box[p, 1]
-            bh = box[p, 3]
-            if y < by0 or y >= by0 + bh:
-                continue
-            bx0 = box[p, 0]
-            bw = box[p, 2]
-            a = colors[p, 3]
-            cr = colors[p, 0]
-            cg = colors[p, 1]
-            cb = colors[p, 2]
-            base = off[p] + (y - by0) * (bw + 1)
-            sr = 0.0
-            sg = 0.0
-            sb = 0.0
-            sa = 0.0
-            for c in range(bw):
-                x = bx0 + c
-                k = base + c
-                g0 = grad_out[y, x, 0]
-                g1 = grad_out[y, x, 1]
-                g2 = grad_out[y, x, 2]
-                dot = (
-                    g0 * (cr - under[k, 0]) + g1 * (cg - under[k, 1]) + g2 * (cb - under[k, 2])
-                )
-                dcov[k] = a * dot
-                cov = min(1.0, abs(acc[k]))
-                if cov > 0.0:
-                    ac = a * cov
-                    sr += g0 * ac
-                    sg += g1 * ac
-                    sb += g2 * ac
-                    sa += cov * dot
-                    keep = 1.0 - ac
-                    grad_out[y, x, 0] = g0 * keep
-                    grad_out[y, x, 1] = g1 * keep
-                    grad_out[y, x, 2] = g2 * keep
-            gcol[p, 0] += sr
-            gcol[p, 1] += sg
-            gcol[p, 2] += sb
-            gcol[p, 3] += sa
-    return dcov, gcol
 
 
 @njit(cache=True, nogil=True)
@@ -429,7 +386,7 @@ def _piece_weights(fp, s0, s1):
 
 
 @njit(cache=True, nogil=True)
-def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, stride):
+def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, doff, stride):
     """Return (gxa, gya, gxb, gyb): dL/d endpoints of edge a->b (box coordinates)."""
     dx = xb - xa
     dy = yb - ya
@@ -457,17 +414,17 @@ def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, stride):
                 up = 0.0
                 if r < bh:
                     k = off + r * stride + c
-                    down = dcov[k] * _one_sided(acc[k], sdx)
+                    down = dcov[k - off + doff] * _one_sided(acc[k], sdx)
                 if r >= 1:
                     k = off + (r - 1) * stride + c
-                    up = -dcov[k] * _one_sided(acc[k], -sdx)
+                    up = -dcov[k - off + doff] * _one_sided(acc[k], -sdx)
                 # dL/dy = -dx_piece F'  ->  F' = -(dL/dy per unit |dx|) * sign / ...
                 fp = -0.5 * (down + up) * sdx
             else:
                 if r >= bh:
                     break
                 k = off + r * stride + c
-                fp = -dcov[k] * _dacc(acc[k])
+                fp = -dcov[k - off + doff] * _dacc(acc[k])
             da, db = _piece_weights(fp, s0, s1)
             ga += da
             gb += db
@@ -483,7 +440,7 @@ def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, stride):
     ye = min(yhi, float(bh))
     inv_dy = 1.0 / dy
     sdy = 1.0 if dy > 0.0 else -1.0
-    vertical_on_grid = dx == 0.0 and xa == math.floor(xa)
+    vertical_on_grid = dx == 0.0 and 0.0 <= xa <= bw and xa == math.floor(xa)
     r0 = int(math.floor(ys))
     r1 = int(math.ceil(ye))
     for r in range(r0, r1):
@@ -499,9 +456,9 @@ def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, stride):
             right = 0.0
             left = 0.0
             if 0 <= c < bw:
-                right = dcov[base + c] * _one_sided(acc[base + c], -sdy) * sdy
+                right = dcov[base + c - off + doff] * _one_sided(acc[base + c], -sdy) * sdy
             if 1 <= c <= bw:
-                left = -dcov[base + c - 1] * _one_sided(acc[base + c - 1], sdy) * sdy
+                left = -dcov[base + c - 1 - off + doff] * _one_sided(acc[base + c - 1], sdy) * sdy
             fp = 0.5 * (right + left)
             da, db = _piece_weights(fp, s0, s1)
             ga += da
@@ -517,7 +474,7 @@ def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, stride):
             continue  # F is constant there: no gradient
         if hi == lo:
             c = int(math.floor(lo))
-            fp = -dcov[base + c] * _dacc(acc[base + c])
+            fp = -dcov[base + c - off + doff] * _dacc(acc[base + c])
             da, db = _piece_weights(fp, s_lo, s_hi)
             ga += da
             gb += db
@@ -531,7 +488,7 @@ def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, stride):
             nx = min(float(c + 1), end)
             s0 = s_lo + (x - x_lo) * ds_dx
             s1 = s_lo + (nx - x_lo) * ds_dx
-            fp = -dcov[base + c] * _dacc(acc[base + c])
+            fp = -dcov[base + c - off + doff] * _dacc(acc[base + c])
             da, db = _piece_weights(fp, s0, s1)
             ga += da
             gb += db
@@ -541,28 +498,79 @@ def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, stride):
 
 
 @njit(cache=True, nogil=True)
-def edge_backward(verts, path_vstart, box, off, acc, dcov):
-    """dL/d(polyline vertex) (V, 2) from dL/dcov."""
-    gverts = np.zeros(verts.shape, np.float64)
+def render_backward(grad_out, verts, path_vstart, box, off, colors, acc, under, dcov):
+    """Gradients of ``render_forward``: (dL/d vertex (V, 2), dL/d colour (P, 4)).
+
+    Paths are visited in reverse paint order. For each: dL/dcov of its box pixels goes to the
+    scratch ``dcov`` (size of the largest box), colour gradients are summed, the running canvas
+    gradient ``grad_out`` (H, W, 3, float64, overwritten) is passed under the path, then the edges
+    of the path turn dL/dcov into vertex gradients.
+    """
     n_paths = box.shape[0]
-    for p in range(n_paths):
+    gverts = np.zeros(verts.shape, np.float64)
+    gcol = np.zeros((n_paths, 4), np.float64)
+    for p in range(n_paths - 1, -1, -1):
         bw = box[p, 2]
         bh = box[p, 3]
         if bw <= 0 or bh <= 0:
             continue
         bx0 = box[p, 0]
         by0 = box[p, 1]
+        a = colors[p, 3]
+        cr = colors[p, 0]
+        cg = colors[p, 1]
+        cb = colors[p, 2]
+        stride = bw + 1
+        o = off[p]
+        sr = 0.0
+        sg = 0.0
+        sb = 0.0
+        sa = 0.0
+        for r in range(bh):
+            y = by0 + r
+            for c in range(bw):
+                x = bx0 + c
+                k = o + r * stride + c
+                g0 = grad_out[y, x, 0]
+                g1 = grad_out[y, x, 1]
+                g2 = grad_out[y, x, 2]
+                dot = g0 * (cr - under[k, 0]) + g1 * (cg - under[k, 1]) + g2 * (cb - under[k, 2])
+                dcov[r * stride + c] = a * dot
+                cov = min(1.0, abs(acc[k]))
+                if cov > 0.0:
+                    ac = a * cov
+                    sr += g0 * ac
+                    sg += g1 * ac
+                    sb += g2 * ac
+                    sa += cov * dot
+                    keep = 1.0 - ac
+                    grad_out[y, x, 0] = g0 * keep
+                    grad_out[y, x, 1] = g1 * keep
+                    grad_out[y, x, 2] = g2 * keep
+        gcol[p, 0] = sr
+        gcol[p, 1] = sg
+        gcol[p, 2] = sb
+        gcol[p, 3] = sa
         v0 = path_vstart[p]
         n = path_vstart[p + 1] - v0
         for e in range(n):
             i = v0 + e
             j = v0 + e + 1 if e + 1 < n else v0
             gxa, gya, gxb, gyb = _edge_backward(
-                verts[i, 0] - bx0, verts[i, 1] - by0, verts[j, 0] - bx0, verts[j, 1] - by0,
-                bw, bh, acc, dcov, off[p], bw + 1,
+                verts[i, 0] - bx0,
+                verts[i, 1] - by0,
+                verts[j, 0] - bx0,
+                verts[j, 1] - by0,
+                bw,
+                bh,
+                acc,
+                dcov,
+                o,
+                0,
+                stride,
             )
             gverts[i, 0] += gxa
             gverts[i, 1] += gya
             gverts[j, 0] += gxb
             gverts[j, 1] += gyb
-    return gverts
+    return gverts, gcol

@@ -20,6 +20,8 @@ from samvg.render import _kernels as K
 FLATTEN_TOLERANCE = 0.05
 #: Largest canvas accepted, in pixels (width * height).
 MAX_PIXELS = 1 << 28
+# Coordinates beyond this many pixels are clamped (no effect on any real scene).
+_FAR = 1e18
 
 _Points = torch.Tensor | np.ndarray | Sequence[torch.Tensor | np.ndarray]
 
@@ -83,7 +85,7 @@ def _flat_points(points: _Points) -> tuple[torch.Tensor, np.ndarray]:
     starts = np.cumsum(np.asarray(counts, dtype=np.int64))
     if not parts:
         return torch.zeros((0, 2), dtype=torch.float32), starts
-    dtype = parts[0].dtype if parts[0].is_floating_point() else torch.float32
+    dtype = torch.float64 if any(p.dtype == torch.float64 for p in parts) else torch.float32
     return torch.cat([p.to(dtype) for p in parts]), starts
 
 
@@ -97,44 +99,56 @@ def _report_nonfinite(arr: np.ndarray, starts: np.ndarray, what: str) -> None:
 
 class _Rasterize(torch.autograd.Function):
     @staticmethod
-    def forward(ctx, flat_pts, colors, starts, width, height, bg, tol):  # type: ignore[override]
-        pts = flat_pts.detach().cpu().numpy().astype(np.float64, copy=False)
-        cols = colors.detach().cpu().numpy().astype(np.float64, copy=False)
+    def forward(  # type: ignore[override]
+        ctx, flat_pts, colors, starts, width, height, bg, tol, grad_enabled
+    ):
+        # C-contiguous float64: one compiled specialization of every kernel serves all inputs.
+        pts = np.ascontiguousarray(flat_pts.detach().cpu().numpy(), dtype=np.float64)
+        # Absurdly far points are pulled in so no coordinate difference overflows float64.
+        clipped = np.abs(pts) > _FAR
+        if clipped.any():
+            pts = np.clip(pts, -_FAR, _FAR)
+        cols = np.ascontiguousarray(colors.detach().cpu().numpy(), dtype=np.float64)
         seg_n, vstart, verts = K.plan_and_flatten(pts, starts, width, height, tol)
         box, off = K.path_boxes(verts, vstart, width, height)
-        need_grad = ctx.needs_input_grad[0] or ctx.needs_input_grad[1]
+        # needs_input_grad ignores torch.no_grad(); keep backward state only if it can be used.
+        keep = grad_enabled and (ctx.needs_input_grad[0] or ctx.needs_input_grad[1])
         n_cells = int(off[-1])
+        largest = int(np.max(np.diff(off))) if len(off) > 1 else 0
         out_dtype = np.float64 if flat_pts.dtype == torch.float64 else np.float32
         try:
-            acc = np.empty(n_cells, np.float64)
-            under = np.empty((n_cells if need_grad else 0, 3), np.float32)
             canvas = np.empty((height, width, 3), out_dtype)
+            acc = np.empty(n_cells if keep else largest, np.float64)
+            under = np.empty((n_cells if keep else 0, 3), np.float32)
         except MemoryError as exc:
             raise InputError(
                 f"scene too large to rasterize: {n_cells} path-box pixels on a "
                 f"{width}x{height} canvas"
             ) from exc
-        K.coverage(verts, vstart, box, off, acc)
-        K.composite(acc, box, off, cols, bg, canvas, under, need_grad)
+        K.render_forward(verts, vstart, box, off, cols, bg, canvas, acc, under, keep)
         ctx.col_dtype = colors.dtype
-        if need_grad:
+        if keep:
             ctx.state = (pts.shape[0], starts, seg_n, vstart, verts, box, off, acc, under, cols)
+            ctx.clipped = clipped if clipped.any() else None
+            ctx.largest = largest
         return torch.from_numpy(canvas).to(dtype=flat_pts.dtype, device=flat_pts.device)
 
     @staticmethod
     @torch.autograd.function.once_differentiable
     def backward(ctx, grad_out):  # type: ignore[override]
         n_ctrl, starts, seg_n, vstart, verts, box, off, acc, under, cols = ctx.state
-        go = np.array(grad_out.detach().cpu().numpy(), dtype=np.float64)
-        dcov, gcol = K.composite_backward(go, acc, under, box, off, cols)
+        go = np.array(grad_out.detach().cpu().numpy(), dtype=np.float64, order="C", copy=True)
+        dcov = np.empty(ctx.largest, np.float64)
+        gverts, gcol = K.render_backward(go, verts, vstart, box, off, cols, acc, under, dcov)
         g_pts = g_col = None
         if ctx.needs_input_grad[0]:
-            gverts = K.edge_backward(verts, vstart, box, off, acc, dcov)
             g = K.flatten_backward(gverts, starts, seg_n, vstart, n_ctrl)
+            if ctx.clipped is not None:
+                g[ctx.clipped] = 0.0
             g_pts = torch.from_numpy(g).to(dtype=grad_out.dtype, device=grad_out.device)
         if ctx.needs_input_grad[1]:
-            g_col = torch.from_numpy(gcol).to(dtype=ctx.col_dtype)
-        return g_pts, g_col, None, None, None, None, None
+            g_col = torch.from_numpy(gcol).to(dtype=ctx.col_dtype, device=grad_out.device)
+        return g_pts, g_col, None, None, None, None, None, None
 
 
 def rasterize(
@@ -159,7 +173,7 @@ def rasterize(
         tolerance: maximum chord error (pixels) when flattening the cubics.
 
     Returns:
-        ``(height, width, 3)`` tensor in the dtype of ``points`` (float32 for integer input),
+        ``(height, width, 3)`` tensor, float64 for float64 ``points``, float32 otherwise,
         paths composited with straight-alpha "over" in paint order, nonzero fill rule.
         Differentiable w.r.t. ``points`` and ``colors`` (analytic boundary gradients).
 
@@ -174,9 +188,11 @@ def rasterize(
     n_paths = len(starts) - 1
     if cols.dim() != 2 or cols.shape[1] != 4 or cols.shape[0] != n_paths:
         raise InputError(f"colors must have shape ({n_paths}, 4), got {tuple(cols.shape)}")
-    if not flat.is_floating_point():
+    # Computation is float64 inside; the image comes back as float64 for float64 points and as
+    # float32 otherwise (integers, half precision and bfloat16 included).
+    if flat.dtype not in (torch.float32, torch.float64):
         flat = flat.to(torch.float32)
-    if not cols.is_floating_point():
+    if cols.dtype not in (torch.float32, torch.float64):
         cols = cols.to(torch.float32)
     if not (tolerance > 0 and np.isfinite(tolerance)):
         raise InputError(f"tolerance must be a positive number, got {tolerance!r}")
@@ -188,7 +204,9 @@ def rasterize(
             bad = int(np.flatnonzero(~np.isfinite(col_np).all(axis=1))[0])
             raise InputError(f"path {bad} has a non-finite colour")
     try:
-        return _Rasterize.apply(flat, cols, starts, width, height, bg, float(tolerance))
+        return _Rasterize.apply(
+            flat, cols, starts, width, height, bg, float(tolerance), torch.is_grad_enabled()
+        )
     except MemoryError as exc:
         raise InputError(f"canvas {width}x{height} is too large to allocate") from exc
 

@@ -112,7 +112,9 @@ def build_sam(name: str = "mobile_sam", **encoder_overrides) -> Sam:
 def _guess_model(keys: set[str]) -> str:
     if "image_encoder.patch_embed.seq.0.c.weight" in keys:
         return "mobile_sam"
-    depth = sum(1 for k in keys if k.startswith("image_encoder.blocks.") and k.endswith(".norm1.weight"))
+    depth = sum(
+        1 for k in keys if k.startswith("image_encoder.blocks.") and k.endswith(".norm1.weight")
+    )
     return {12: "vit_b", 24: "vit_l", 32: "vit_h"}.get(depth, "unknown")
 
 
@@ -121,8 +123,16 @@ def read_checkpoint(path: str | os.PathLike[str]) -> dict[str, torch.Tensor]:
     p = Path(path)
     try:
         obj = torch.load(p, map_location="cpu", weights_only=True)
-    except (RuntimeError, pickle.UnpicklingError, EOFError, zipfile.BadZipFile, OSError,
-            ValueError, KeyError, AttributeError) as e:
+    except (
+        RuntimeError,
+        pickle.UnpicklingError,
+        EOFError,
+        zipfile.BadZipFile,
+        OSError,
+        ValueError,
+        KeyError,
+        AttributeError,
+    ) as e:
         raise WeightsError(
             f"cannot read SAM checkpoint {p}: {type(e).__name__}: {str(e).splitlines()[0][:200]}"
             " (corrupt or truncated file? re-download it)"
@@ -136,7 +146,9 @@ def read_checkpoint(path: str | os.PathLike[str]) -> dict[str, torch.Tensor]:
     return dict(obj)
 
 
-def check_state_dict(model: nn.Module, state: Mapping[str, torch.Tensor], name: str, src: str) -> None:
+def check_state_dict(
+    model: nn.Module, state: Mapping[str, torch.Tensor], name: str, src: str
+) -> None:
     """Raise `WeightsError` unless ``state`` has exactly the model's keys and shapes."""
     expected = model.state_dict()
     missing = sorted(set(expected) - set(state))

@@ -1,3 +1,370 @@
-"""Placeholder."""
+"""Fast exact mask decoding for many prompts on one image (low-rank two-way transformer).
+
+Why it is exact and fast. All prompts share the image embedding; the only per-prompt change to
+the 4096 image tokens comes from the image->token attentions, whose output is
+``A @ U``: softmax weights ``A`` (4096 x heads*T, T ~ 7 prompt tokens) times a per-prompt
+matrix ``U = blockdiag(V_h) @ W_out``. So after each image->token attention the image tokens
+are ``x = s * (Y + D @ R) + c``: a shared matrix ``Y`` scaled per token by ``s``, a low-rank
+per-prompt part (``D``: 4096 x r coefficients, ``R``: r x 256), and a shared vector ``c``.
+LayerNorm keeps that form exactly (its mean and variance are computed from the factors:
+``|x_c|^2 = s^2|Y_c|^2 + 2 s (Y_c R^T).D + diag(D (R R^T) D^T)``), and every linear layer
+applied to the image tokens (k/v/q projections, the first transposed convolution) maps ``Y``
+once per image and ``R`` per prompt, so attention logits and weighted sums are computed from
+``D`` directly, never materialising per-prompt 4096x256 tensors. ``R`` itself is kept
+factored as per-head prompt values (B, H, T, 16) times shared (128 x 256) weights.
+
+Only the second transposed convolution, its GELUs and the hypernetwork dot products run per
+prompt at full size, and only for the prompts that need masks (`masks`), restricted to the
+part of the 64x64 grid that covers the image (the rest is padding).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import torch
+import torch.nn.functional as F
+
+from samvg.sam.model import Sam
+from samvg.sam.transformer import Attention
+
+
+def _heads(x: torch.Tensor, h: int) -> torch.Tensor:
+    """(..., N, h*d) -> (..., h, N, d)."""
+    *lead, n, c = x.shape
+    return x.reshape(*lead, n, h, c // h).transpose(-3, -2)
+
+
+def _lin(x: torch.Tensor, layer: torch.nn.Linear) -> torch.Tensor:
+    return F.linear(x, layer.weight, layer.bias)
+
+
+def _factor(vt: torch.Tensor, m: torch.Tensor) -> torch.Tensor:
+    """Rows of a factored low-rank basis: vt (B, H, T, d) and m (H*d, X) -> (B, H*T, X)."""
+    b, h, t, d = vt.shape
+    return torch.matmul(vt, m.view(h, d, -1)).reshape(b, h * t, -1)
+
+
+def _center(x: torch.Tensor, dim: int = -1) -> torch.Tensor:
+    return x - x.mean(dim, keepdim=True)
+
+
+@dataclass
+class DecoderState:
+    """Per-prompt results of the transformer, enough to make IoU scores and masks."""
+
+    iou: torch.Tensor  # (B, 4) predicted IoU of all 4 mask tokens
+    hyper: torch.Tensor  # (B, 4, 32) hypernetwork outputs of all 4 mask tokens
+    s1: torch.Tensor  # (B, N) 1/std of the first image LayerNorm
+    s2: torch.Tensor  # (B, N) 1/std of the second image LayerNorm
+    d: torch.Tensor  # (B, N, r) low-rank coefficients of the image tokens
+    vt1: torch.Tensor  # (B, H, T, dh) values of the first image->token attention
+    vt2: torch.Tensor  # (B, H, T, dh) values of the second image->token attention
+
+    def select(self, idx: torch.Tensor) -> DecoderState:
+        return DecoderState(*(getattr(self, f)[idx] for f in self.__dataclass_fields__))
+
+
 class FastDecoder:
-    pass
+    """Mask decoder for one image embedding, exact up to float rounding (see module doc).
+
+    ``decode(sparse)`` matches ``MaskDecoder`` (logits for the full 256x256 grid);
+    ``transformer(sparse)`` + ``masks(state, ...)`` split the work so callers can reject
+    prompts by predicted IoU before computing any mask.
+    """
+
+    def __init__(self, model: Sam, image_embedding: torch.Tensor) -> None:
+        if image_embedding.dim() != 4 or image_embedding.shape[0] != 1:
+            raise ValueError("FastDecoder expects one image embedding (1, C, H, W)")
+        self.model = model
+        md = model.mask_decoder
+        tr = md.transformer
+        if tr.depth != 2:
+            raise ValueError("FastDecoder supports SAM's two-layer two-way transformer")
+        self.md = md
+        self.tr = tr
+        with torch.inference_mode():
+            self._precompute(image_embedding)
+
+    # ------------------------------------------------------------------ shared, per image
+    def _precompute(self, emb: torch.Tensor) -> None:
+        md, tr = self.md, self.tr
+        pe_enc = self.model.prompt_encoder
+        l0, l1 = tr.layers
+        fa = tr.final_attn_token_to_image
+        self.h = h = l0.cross_attn_image_to_token.num_heads
+        _, c, gh, gw = emb.shape
+        self.grid = (gh, gw)
+        e = emb[0].flatten(1).t()  # (N, C)
+        s0 = e + pe_enc.no_mask_embed.weight[0]
+        p = pe_enc.get_dense_pe()[0].flatten(1).t()
+        self.n = s0.shape[0]
+
+        def sc(att: Attention) -> float:
+            return 1.0 / math.sqrt(att.internal_dim // att.num_heads)
+
+        # layer 0, token -> image: keys and values are shared
+        a = l0.cross_attn_token_to_image
+        self.k0 = _heads(_lin(s0 + p, a.k_proj), h)
+        self.v0 = _heads(_lin(s0, a.v_proj), h)
+        # layer 0, image -> token: image queries are shared
+        a = l0.cross_attn_image_to_token
+        self.q1 = _heads(_lin(s0 + p, a.q_proj), h) * sc(a)
+        wo1, bo1 = a.out_proj.weight, a.out_proj.bias  # (C, 128)
+        y1c = _center(s0 + bo1)
+        self.y1_sq = (y1c * y1c).sum(1)
+        self.e1 = _heads(y1c @ wo1, h)  # (H, N, dh): Y1c . U1 rows
+        m1c = _center(wo1.t())  # (128, C) factored basis of U1, centred along C
+        self.m1c = m1c
+        self.gram1 = m1c @ m1c.t()  # (128, 128)
+        g1, b1 = l0.norm4.weight, l0.norm4.bias
+        self.eps1 = l0.norm4.eps
+        yb1 = y1c * g1  # keys1 = s1 * (yb1 + A1 R1) + b1, with R1 = vt1 (m1c * g1)
+        m1 = m1c * g1
+        # layer 1, token -> image
+        a = l1.cross_attn_token_to_image
+        self.zk2 = _heads(F.linear(yb1, a.k_proj.weight), h)
+        self.kc2 = _heads(_lin(p + b1, a.k_proj), h)
+        self.m1k = m1 @ a.k_proj.weight.t()
+        self.zv2 = _heads(F.linear(yb1, a.v_proj.weight), h)
+        self.vc2 = _lin(b1, a.v_proj).view(h, 1, -1)
+        self.m1v = m1 @ a.v_proj.weight.t()
+        # layer 1, image -> token
+        a = l1.cross_attn_image_to_token
+        s = sc(a)
+        self.zq3 = _heads(F.linear(yb1, a.q_proj.weight), h) * s
+        self.qc3 = _heads(_lin(p + b1, a.q_proj), h) * s
+        self.m1q = (m1 @ a.q_proj.weight.t()) * s
+        wo3, bo3 = a.out_proj.weight, a.out_proj.bias
+        # second LayerNorm: x2 = s1*yb1 + (s1*A1) R1 + A2 R2 + (b1 + bo3)
+        yb1c = _center(yb1)
+        self.yb1c_sq = (yb1c * yb1c).sum(1)
+        m1cc = _center(m1)
+        m2c = _center(wo3.t())
+        cc = _center(b1 + bo3)
+        self.basis = torch.cat([m1cc, m2c], 0)  # (256, C): rows of R1 (first 128), R2 (last)
+        self.cc = cc
+        self.e2 = _heads(yb1c @ self.basis.t(), h * 2)  # (2H, N, dh)
+        self.y_cc = yb1c @ cc
+        g2, b2 = l1.norm4.weight, l1.norm4.bias
+        self.eps2 = l1.norm4.eps
+        # keys2 = s2 * (s1 * yb1c*g2 + D' R'*g2) + b2 with D' = [s1 A1, A2, 1]
+        y2 = yb1c * g2
+        self.y2 = y2
+        self.b2 = b2
+        basis2 = torch.cat([self.basis, cc[None]], 0) * g2  # (257, C)
+        self.basis2 = basis2
+        # final token -> image attention
+        self.zkf = _heads(F.linear(y2, fa.k_proj.weight), h)
+        self.kcf = _heads(_lin(p + b2, fa.k_proj), h)
+        self.mkf = basis2 @ fa.k_proj.weight.t()  # (257, 128)
+        self.zvf = _heads(F.linear(y2, fa.v_proj.weight), h)
+        self.vcf = _lin(b2, fa.v_proj).view(h, 1, -1)
+        self.mvf = basis2 @ fa.v_proj.weight.t()
+        # output upscaling, first transposed conv as a (C, 4*C/4) matrix, columns (a, b, ch)
+        up = md.output_upscaling
+        w1 = up[0].weight  # (C, C/4, 2, 2)
+        self.c4 = w1.shape[1]
+        self.wt1 = w1.permute(0, 2, 3, 1).reshape(w1.shape[0], -1)
+        self.bt1 = up[0].bias.repeat(4)
+        self.ln_up = up[1]
+        w2 = up[3].weight  # (C/4, C/8, 2, 2)
+        self.c8 = w2.shape[1]
+        self.wt2 = w2.permute(0, 2, 3, 1).reshape(w2.shape[0], -1)
+        self.bt2 = up[3].bias.repeat(4)
+        self.yt = y2 @ self.wt1  # (N, 4*C/4), scaled by s2*s1 per prompt
+        self.ct = b2 @ self.wt1 + self.bt1
+        self.mt = basis2 @ self.wt1  # (257, 4*C/4)
+
+    # ------------------------------------------------------------------ per prompt
+    def _t2i_shared(self, q: torch.Tensor, k: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+        """Token->image attention against shared keys/values: q (B, H, T, d), k/v (H, N, d)."""
+        b, h, t, d = q.shape
+        qh = q.transpose(0, 1).reshape(h, b * t, d) / math.sqrt(d)
+        att = torch.softmax(qh @ k.transpose(1, 2), dim=-1)
+        return (att @ v).view(h, b, t, d).transpose(0, 1)
+
+    def _t2i_lowrank(
+        self,
+        q: torch.Tensor,
+        scale: torch.Tensor,
+        inner: torch.Tensor | None,
+        z_k: torch.Tensor,
+        d: torch.Tensor,
+        r_k: torch.Tensor,
+        kc: torch.Tensor,
+        z_v: torch.Tensor,
+        r_v: torch.Tensor,
+        vc: torch.Tensor,
+    ) -> torch.Tensor:
+        """Token->image attention on image tokens ``s*(inner*Z + D R) + const``.
+
+        q (B, H, T, d) already scaled; scale = s (B, N); inner (B, N) or None; z_* (H, N, d)
+        shared; d (B, N, r); r_* (B, r, H*d) per prompt; kc (H, N, d) shared; vc (H, 1, d).
+        """
+        b, h, t, dd = q.shape
+        n = z_k.shape[1]
+        qh = q.transpose(0, 1).reshape(h, b * t, dd)
+        zk = torch.cat([z_k, kc], dim=1)  # (H, 2N, d)
+        both = (qh @ zk.transpose(1, 2)).view(h, b, t, 2, n).permute(1, 0, 2, 3, 4)
+        a_sh, a_c = both[:, :, :, 0], both[:, :, :, 1]
+        if inner is not None:
+            a_sh = a_sh * inner[:, None, None, :]
+        # (B, H, T, r) = q_h . r_k,h
+        qr = torch.matmul(q, r_k.view(b, -1, h, dd).permute(0, 2, 3, 1))
+        a_lr = torch.bmm(qr.reshape(b, h * t, -1), d.transpose(1, 2)).view(b, h, t, n)
+        logits = (a_sh + a_lr) * scale[:, None, None, :] + a_c
+        att = torch.softmax(logits, dim=-1)
+        att_s = att * scale[:, None, None, :]
+        w_sh = att_s * inner[:, None, None, :] if inner is not None else att_s
+        o_sh = torch.matmul(w_sh.transpose(0, 1).reshape(h, b * t, n), z_v)
+        o_sh = o_sh.view(h, b, t, dd).transpose(0, 1)
+        pd = torch.bmm(att_s.reshape(b, h * t, n), d).view(b, h, t, -1)
+        o_lr = torch.matmul(pd, r_v.view(b, -1, h, dd).transpose(1, 2))
+        return o_sh + o_lr + vc
+
+    def transformer(self, sparse: torch.Tensor) -> DecoderState:
+        """Run the two-way transformer for B prompts (sparse tokens (B, Ts, C))."""
+        md, tr = self.md, self.tr
+        l0, l1 = tr.layers
+        fa = tr.final_attn_token_to_image
+        h = self.h
+        b = sparse.shape[0]
+        tok = torch.cat([md.output_tokens().unsqueeze(0).expand(b, -1, -1), sparse], dim=1)
+        t = tok.shape[1]
+        pe = tok
+        # ---- layer 0 (no PE in the self attention, its output replaces the tokens)
+        q = l0.norm1(l0.self_attn(tok, tok, tok))
+        a = l0.cross_attn_token_to_image
+        qq = _heads(_lin(q + pe, a.q_proj), h)
+        o = self._t2i_shared(qq, self.k0, self.v0)
+        q = l0.norm2(q + a.out_proj(o.transpose(1, 2).reshape(b, t, -1)))
+        q = l0.norm3(q + l0.mlp(q))
+        a = l0.cross_attn_image_to_token
+        kt = _heads(_lin(q + pe, a.k_proj), h)  # (B, H, T, d)
+        vt1 = _heads(_lin(q, a.v_proj), h)
+        n = self.n
+        # image->token logits (B, N, H, T); image queries shared
+        lg = torch.matmul(self.q1.unsqueeze(0), kt.transpose(2, 3))  # (B, H, N, T)
+        a1 = torch.softmax(lg, dim=-1).permute(0, 2, 1, 3).reshape(b, n, h * t)
+        # LayerNorm statistics of x1 = Y1 + A1 U1
+        cross = torch.matmul(self.e1.unsqueeze(0), vt1.transpose(2, 3))  # (B, H, N, T)
+        cross = (cross.permute(0, 2, 1, 3).reshape(b, n, h * t) * a1).sum(-1)
+        u1 = _factor(vt1, self.m1c)  # (B, HT, C) centred rows of U1
+        g = torch.bmm(u1, u1.transpose(1, 2))
+        quad = (torch.bmm(a1, g) * a1).sum(-1)
+        c = self.y2.shape[1]
+        var1 = (self.y1_sq + 2 * cross + quad) / c
+        s1 = torch.rsqrt(var1 + self.eps1)
+        # ---- layer 1
+        q1 = q + pe
+        q = l1.norm1(q + l1.self_attn(q1, q1, q))
+        a = l1.cross_attn_token_to_image
+        qq = _heads(_lin(q + pe, a.q_proj), h) / math.sqrt(a.internal_dim // h)
+        o = self._t2i_lowrank(
+            qq,
+            s1,
+            None,
+            self.zk2,
+            a1,
+            _factor(vt1, self.m1k),
+            self.kc2,
+            self.zv2,
+            _factor(vt1, self.m1v),
+            self.vc2,
+        )
+        q = l1.norm2(q + a.out_proj(o.transpose(1, 2).reshape(b, t, -1)))
+        q = l1.norm3(q + l1.mlp(q))
+        a = l1.cross_attn_image_to_token
+        kt = _heads(_lin(q + pe, a.k_proj), h)
+        vt2 = _heads(_lin(q, a.v_proj), h)
+        # logits (B, H, N, T) = s1 * (Zq kt + A1 (R1q kt)) + Qc kt
+        kt_all = kt.transpose(0, 1).reshape(h, b * t, -1).transpose(1, 2)  # (H, d, BT)
+        lz = torch.matmul(self.zq3, kt_all).view(h, n, b, t).permute(2, 0, 1, 3)
+        lc = torch.matmul(self.qc3, kt_all).view(h, n, b, t).permute(2, 0, 1, 3)
+        r1q = _factor(vt1, self.m1q).view(b, h * t, h, -1).transpose(1, 2)  # (B, H, HT, d)
+        rk = torch.matmul(r1q, kt.transpose(2, 3))  # (B, H, HT, T)
+        llr = torch.bmm(a1, rk.permute(0, 2, 1, 3).reshape(b, h * t, h * t))
+        llr = llr.view(b, n, h, t).permute(0, 2, 1, 3)
+        lg = (lz + llr) * s1[:, None, :, None] + lc
+        a2 = torch.softmax(lg, dim=-1).permute(0, 2, 1, 3).reshape(b, n, h * t)
+        # second LayerNorm: x2c = s1*Yc + D' R' with D' = [s1*A1, A2, 1]
+        d = torch.cat([a1 * s1[:, :, None], a2], dim=2)  # (B, N, 2HT)
+        vt12 = torch.cat([vt1, vt2], dim=1)  # (B, 2H, T, d)
+        cross = torch.matmul(self.e2.unsqueeze(0), vt12.transpose(2, 3))  # (B, 2H, N, T)
+        cross = (cross.permute(0, 2, 1, 3).reshape(b, n, 2 * h * t) * d).sum(-1) + self.y_cc
+        r = torch.cat([_factor(vt12, self.basis), self.cc.expand(b, 1, -1)], dim=1)  # (B, 2HT+1, C)
+        g = torch.bmm(r, r.transpose(1, 2))
+        dq = torch.bmm(d, g[:, :-1, :-1])
+        quad = (dq * d).sum(-1) + 2 * torch.bmm(d, g[:, :-1, -1:]).squeeze(-1) + g[:, -1, -1:]
+        var2 = (s1 * s1 * self.yb1c_sq + 2 * s1 * cross + quad) / c
+        s2 = torch.rsqrt(var2 + self.eps2)
+        # ---- final token -> image attention
+        # only the IoU token and the mask tokens are read after the final attention
+        k_out = 1 + md.num_mask_tokens
+        q, pe = q[:, :k_out], pe[:, :k_out]
+        qf = _heads(_lin(q + pe, fa.q_proj), h) / math.sqrt(fa.internal_dim // h)
+        rkf = self._basis_rows(vt12, self.mkf)
+        rvf = self._basis_rows(vt12, self.mvf)
+        d1 = torch.cat([d, torch.ones_like(d[:, :, :1])], dim=2)
+        o = self._t2i_lowrank(qf, s2, s1, self.zkf, d1, rkf, self.kcf, self.zvf, rvf, self.vcf)
+        q = tr.norm_final_attn(q + fa.out_proj(o.transpose(1, 2).reshape(b, k_out, -1)))
+        iou = md.iou_prediction_head(q[:, 0, :])
+        mt = q[:, 1 : 1 + md.num_mask_tokens, :]
+        hyper = torch.stack(
+            [mlp(mt[:, i, :]) for i, mlp in enumerate(md.output_hypernetworks_mlps)], dim=1
+        )
+        return DecoderState(iou, hyper, s1, s2, d1, vt1, vt2)
+
+    def _basis_rows(self, vt12: torch.Tensor, m: torch.Tensor) -> torch.Tensor:
+        """Rows of R' mapped by a shared matrix: m (257, X) -> (B, 2HT+1, X)."""
+        b = vt12.shape[0]
+        return torch.cat([_factor(vt12, m[:-1]), m[-1:].expand(b, 1, -1)], dim=1)
+
+    def masks(
+        self,
+        state: DecoderState,
+        mask_ids: list[int] | torch.Tensor,
+        grid_hw: tuple[int, int] | None = None,
+    ) -> torch.Tensor:
+        """Low-res mask logits (B, M, 4*gh, 4*gw) of mask tokens ``mask_ids`` (0..3).
+
+        Only the top-left ``grid_hw`` cells of the 64x64 embedding grid are upscaled (the rest
+        covers padding); default: the whole grid (256x256 logits).
+        """
+        gh, gw = grid_hw if grid_hw is not None else self.grid
+        b = state.s1.shape[0]
+        n_full = self.n
+        rows = torch.arange(gh)[:, None] * self.grid[1] + torch.arange(gw)[None, :]
+        sel = rows.flatten()
+        nv = sel.numel()
+        full = nv == n_full
+        d = state.d if full else state.d[:, sel]
+        s1 = state.s1 if full else state.s1[:, sel]
+        s2 = state.s2 if full else state.s2[:, sel]
+        yt = self.yt if full else self.yt[sel]
+        vt12 = torch.cat([state.vt1, state.vt2], dim=1)
+        rt = self._basis_rows(vt12, self.mt)  # (B, r+1, 4*C4)
+        x = torch.baddbmm(yt.unsqueeze(0) * s1[:, :, None], d, rt)
+        x = x * s2[:, :, None] + self.ct  # (B, Nv, 4*C4), first transposed conv output
+        c4 = self.c4
+        x = x.view(b, nv, 4, c4)
+        x = F.layer_norm(x, (c4,), None, None, self.ln_up.eps)
+        x = F.gelu(x * self.ln_up.weight + self.ln_up.bias)
+        z = torch.matmul(x, self.wt2) + self.bt2  # (B, Nv, 4, 4*C8)
+        z = F.gelu(z).view(b, nv * 16, self.c8)
+        hyper = state.hyper[:, list(mask_ids) if not torch.is_tensor(mask_ids) else mask_ids]
+        m = torch.bmm(z, hyper.transpose(1, 2))  # (B, Nv*16, M)
+        nm = m.shape[-1]
+        m = m.view(b, gh, gw, 2, 2, 2, 2, nm).permute(0, 7, 1, 3, 5, 2, 4, 6)
+        return m.reshape(b, nm, 4 * gh, 4 * gw)
+
+    def decode(
+        self, sparse: torch.Tensor, multimask_output: bool = True
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Same outputs as ``MaskDecoder.forward`` with the no-mask dense prompt."""
+        with torch.inference_mode():
+            st = self.transformer(sparse)
+            ids = [1, 2, 3] if multimask_output else [0]
+            return self.masks(st, ids), st.iou[:, ids]

@@ -73,8 +73,10 @@ class MaskDecoder(nn.Module):
         b = sparse_prompt_embeddings.shape[0]
         out = self.output_tokens().unsqueeze(0).expand(b, -1, -1)
         tokens = torch.cat([out, sparse_prompt_embeddings], dim=1)
-        src = image_embeddings.expand(b, -1, -1, -1) if image_embeddings.shape[0] == 1 else (
-            image_embeddings
+        src = (
+            image_embeddings.expand(b, -1, -1, -1)
+            if image_embeddings.shape[0] == 1
+            else (image_embeddings)
         )
         src = src + dense_prompt_embeddings
         pos = image_pe.expand(b, -1, -1, -1)

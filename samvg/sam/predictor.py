@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import torch
 
@@ -12,36 +14,53 @@ from samvg.sam.model import Sam
 
 
 def resize_logits(
-    logits: torch.Tensor, input_size: tuple[int, int], original_size: tuple[int, int]
+    logits: torch.Tensor,
+    input_size: tuple[int, int],
+    original_size: tuple[int, int],
+    grid: int = 256,
 ) -> torch.Tensor:
-    """Bilinearly resample (..., 256, 256) low-res logits straight to ``original_size``.
+    """Bilinearly resample low-res logits (..., h, w) straight to ``original_size``.
 
-    The low-res grid covers the padded 1024x1024 model input, of which the top-left
-    ``input_size`` is the resized image. One separable bilinear resampling (half-pixel
-    centres, like ``align_corners=False``) replaces upstream SAM's upscale-crop-resize.
+    The logits are the top-left part (h, w <= ``grid``) of SAM's ``grid`` x ``grid`` low-res
+    output, which covers the padded 1024 x 1024 model input whose top-left ``input_size`` is
+    the resized image. One separable bilinear resampling (half-pixel centres, like
+    ``align_corners=False``) replaces upstream SAM's upscale-crop-resize; the logits must cover
+    rows/cols up to ``ceil(input_size / 4)`` inclusive (see `needed_lowres`).
     """
-    lr = logits.shape[-1]
-    img_size = 4 * lr  # 1024 for SAM
+    img_size = 4 * grid
+    h_av, w_av = logits.shape[-2:]
 
-    def axis(n_out: int, n_in: int) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    def axis(n_out: int, n_in: int, avail: int):
         pos = (torch.arange(n_out, dtype=torch.float32, device=logits.device) + 0.5) * (
             n_in / n_out
-        ) * (lr / img_size) - 0.5
-        pos = pos.clamp(min=0.0, max=lr - 1)
+        ) * (grid / img_size) - 0.5
+        pos = pos.clamp(min=0.0, max=grid - 1)
         i0 = pos.floor().long()
-        i1 = (i0 + 1).clamp(max=lr - 1)
+        i1 = (i0 + 1).clamp(max=grid - 1)
+        if int(i1.max()) >= avail:
+            raise ValueError("low-res logits do not cover the image region")
         return i0, i1, pos - i0
 
-    y0, y1, wy = axis(original_size[0], input_size[0])
-    x0, x1, wx = axis(original_size[1], input_size[1])
+    y0, y1, wy = axis(original_size[0], input_size[0], h_av)
+    x0, x1, wx = axis(original_size[1], input_size[1], w_av)
     rows = logits[..., y0, :] * (1 - wy)[:, None] + logits[..., y1, :] * wy[:, None]
     return rows[..., x0] * (1 - wx) + rows[..., x1] * wx
+
+
+def needed_lowres(input_size: tuple[int, int], grid: int = 256) -> tuple[int, int]:
+    """Rows/cols of the low-res logits that `resize_logits` reads for this input size."""
+    return (
+        min(grid, math.ceil(input_size[0] / 4) + 1),
+        min(grid, math.ceil(input_size[1] / 4) + 1),
+    )
 
 
 def _as_float_array(x, shape_tail: tuple[int, ...], what: str) -> np.ndarray:
     arr = np.asarray(x, dtype=np.float64)
     if arr.ndim != len(shape_tail) + 1 or arr.shape[1:] != shape_tail:
-        raise InputError(f"{what} must have shape (N, {', '.join(map(str, shape_tail))}), got {arr.shape}")
+        raise InputError(
+            f"{what} must have shape (N, {', '.join(map(str, shape_tail))}), got {arr.shape}"
+        )
     if not np.isfinite(arr).all():
         raise InputError(f"{what} contains NaN or infinite values")
     return arr
@@ -80,14 +99,13 @@ class SamPredictor:
             raise InputError(f"image_format must be 'RGB' or 'BGR', got {image_format!r}")
         self.reset_image()
         resized = resize_longest_side(np.ascontiguousarray(img), self.model.img_size)
-        x = torch.as_tensor(resized, device=self.model.device).permute(2, 0, 1)[None].float()
+        x = torch.from_numpy(np.array(resized, dtype=np.float32)).to(self.model.device)
+        x = x.permute(2, 0, 1)[None]
         self.original_size = (img.shape[0], img.shape[1])
         self.input_size = (resized.shape[0], resized.shape[1])
         self.features = self.model.image_encoder(self.model.preprocess(x))
 
-    def set_features(
-        self, features: torch.Tensor, original_size: tuple[int, int]
-    ) -> None:
+    def set_features(self, features: torch.Tensor, original_size: tuple[int, int]) -> None:
         """Reuse an image embedding (1, 256, 64, 64) computed earlier for an image of this size."""
         self.reset_image()
         self.features = features
@@ -141,7 +159,10 @@ class SamPredictor:
             pl = np.asarray(point_labels, dtype=np.float64).reshape(-1)
             if pl.shape[0] != pc.shape[0]:
                 raise InputError("point_coords and point_labels have different lengths")
-            points = (self.transform_coords(pc)[None], torch.as_tensor(pl, dtype=torch.float32)[None])
+            points = (
+                self.transform_coords(pc)[None],
+                torch.as_tensor(pl, dtype=torch.float32)[None],
+            )
         boxes = None
         if box is not None:
             b = _as_float_array(np.asarray(box).reshape(1, 4), (4,), "box")

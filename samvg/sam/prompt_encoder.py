@@ -31,7 +31,9 @@ class PositionEmbeddingRandom(nn.Module):
         grid = torch.stack(torch.meshgrid(x, y, indexing="xy"), dim=-1)  # (h, w, 2) as (x, y)
         return self._encode(grid).permute(2, 0, 1)
 
-    def forward_with_coords(self, coords: torch.Tensor, image_size: tuple[int, int]) -> torch.Tensor:
+    def forward_with_coords(
+        self, coords: torch.Tensor, image_size: tuple[int, int]
+    ) -> torch.Tensor:
         """Encode pixel coordinates (..., 2) given as (x, y) in an image of size (h, w)."""
         coords = coords.clone().float()
         coords[..., 0] = coords[..., 0] / image_size[1]

@@ -207,9 +207,7 @@ class BasicLayer(nn.Module):
         self.blocks = nn.ModuleList(
             TinyViTBlock(dim, resolution, num_heads, window, mlp_ratio) for _ in range(depth)
         )
-        self.downsample = (
-            PatchMerging(resolution, dim, out_dim) if out_dim is not None else None
-        )
+        self.downsample = PatchMerging(resolution, dim, out_dim) if out_dim is not None else None
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         for blk in self.blocks:

@@ -59,7 +59,10 @@ def svg_text(points: np.ndarray, colors: np.ndarray, width: int, height: int) ->
     image = VectorImage(
         width,
         height,
-        [VectorPath(np.asarray(p), tuple(float(v) for v in c)) for p, c in zip(points, colors)],
+        [
+            VectorPath(np.asarray(p), tuple(float(v) for v in c))
+            for p, c in zip(points, colors, strict=True)
+        ],
         (1.0, 1.0, 1.0),
     )
     return image.to_svg(precision=6)
@@ -132,7 +135,7 @@ def supersampled_render(
 ) -> np.ndarray:
     """Reference image: 16x16 point samples per pixel, nonzero rule, straight-alpha over white."""
     canvas = np.ones((height, width, 3), np.float64)
-    for ctrl, col in zip(points, colors):
+    for ctrl, col in zip(points, colors, strict=True):
         cov = _path_coverage_ss(fine_polygon(np.asarray(ctrl, np.float64)), width, height, ss)
         ac = (col[3] * cov)[..., None]
         canvas = canvas * (1 - ac) + np.asarray(col[:3])[None, None, :] * ac

@@ -1,0 +1,247 @@
+"""SamAutomaticMaskGenerator: grid-prompted masks for a whole image, CPU-fast."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import torch
+
+from samvg.sam.amg_utils import (
+    batched_mask_to_box,
+    box_area,
+    build_all_layer_point_grids,
+    generate_crop_boxes,
+    is_box_near_crop_edge,
+    nms,
+    remove_small_regions,
+    stability_score,
+    uncrop_boxes_xyxy,
+    uncrop_masks,
+    uncrop_points,
+)
+from samvg.sam.image import to_rgb_uint8
+from samvg.sam.model import Sam
+from samvg.sam.predictor import SamPredictor, needed_lowres, resize_logits
+
+
+class SamAutomaticMaskGenerator:
+    """Segment everything: prompt SAM with a point grid (and optional zoomed crops).
+
+    Same parameters and output as upstream SAM's generator (binary-mask output). Speed: per
+    crop the image is encoded once, prompts run in batches through `FastDecoder`; masks whose
+    predicted IoU is below ``pred_iou_thresh`` are never computed, the stability score is
+    taken on the 256x256 low-res logits (the part covering the image), and only survivors are
+    upsampled, straight to the crop's own resolution. NMS runs in torch.
+
+    Differences from upstream (documented, deliberate): stability is measured on low-res
+    logits rather than on logits upsampled to the image size, and masks are resampled from
+    256x256 to the image size in one bilinear step.
+    """
+
+    def __init__(
+        self,
+        model: Sam,
+        points_per_side: int | None = 32,
+        points_per_batch: int = 8,
+        pred_iou_thresh: float = 0.88,
+        stability_score_thresh: float = 0.95,
+        stability_score_offset: float = 1.0,
+        box_nms_thresh: float = 0.7,
+        crop_n_layers: int = 0,
+        crop_nms_thresh: float = 0.7,
+        crop_overlap_ratio: float = 512 / 1500,
+        crop_n_points_downscale_factor: int = 1,
+        point_grids: list[np.ndarray] | None = None,
+        min_mask_region_area: int = 0,
+        mask_batch: int = 2,
+    ) -> None:
+        if (points_per_side is None) == (point_grids is None):
+            raise ValueError("give exactly one of points_per_side and point_grids")
+        if point_grids is None:
+            assert points_per_side is not None
+            if points_per_side < 1:
+                raise ValueError("points_per_side must be >= 1")
+            point_grids = build_all_layer_point_grids(
+                points_per_side, crop_n_layers, crop_n_points_downscale_factor
+            )
+        elif len(point_grids) != crop_n_layers + 1:
+            raise ValueError("point_grids needs one grid per crop layer")
+        self.predictor = SamPredictor(model, fast=True)
+        self.model = model
+        self.point_grids = point_grids
+        self.points_per_batch = max(1, int(points_per_batch))
+        self.pred_iou_thresh = pred_iou_thresh
+        self.stability_score_thresh = stability_score_thresh
+        self.stability_score_offset = stability_score_offset
+        self.box_nms_thresh = box_nms_thresh
+        self.crop_n_layers = crop_n_layers
+        self.crop_nms_thresh = crop_nms_thresh
+        self.crop_overlap_ratio = crop_overlap_ratio
+        self.min_mask_region_area = min_mask_region_area
+        self.mask_batch = max(1, int(mask_batch))
+        self.timings: dict[str, float] = {}
+
+    @torch.inference_mode()
+    def generate(self, image) -> list[dict[str, Any]]:
+        """Masks for an image (H, W, 3) uint8 RGB (other inputs converted, see `to_rgb_uint8`).
+
+        Returns a list of dicts with ``segmentation`` (bool H x W), ``area``, ``bbox`` (XYWH),
+        ``predicted_iou``, ``point_coords`` ([[x, y]]), ``stability_score``, ``crop_box`` (XYWH).
+        """
+        import time
+
+        img = to_rgb_uint8(image)
+        self.timings = {"encoder": 0.0, "decoder": 0.0, "masks": 0.0, "post": 0.0}
+        orig_size = (img.shape[0], img.shape[1])
+        crop_boxes, layer_idxs = generate_crop_boxes(
+            orig_size, self.crop_n_layers, self.crop_overlap_ratio
+        )
+        parts = []
+        for crop_box, layer in zip(crop_boxes, layer_idxs, strict=True):
+            parts.append(self._process_crop(img, crop_box, layer, orig_size))
+        t0 = time.perf_counter()
+        data = _cat(parts)
+        if len(crop_boxes) > 1 and len(data["iou"]):
+            scores = 1.0 / box_area(data["crop_boxes"]).float().clamp(min=1)
+            keep = nms(data["boxes"].float(), scores, self.crop_nms_thresh)
+            data = _filter(data, keep)
+        if self.min_mask_region_area > 0 and len(data["iou"]):
+            data = self._postprocess_small_regions(
+                data, self.min_mask_region_area, max(self.box_nms_thresh, self.crop_nms_thresh)
+            )
+        out = []
+        masks = data["masks"].cpu().numpy()
+        areas = masks.reshape(len(masks), -1).sum(1) if len(masks) else []
+        for i in range(len(masks)):
+            x0, y0, x1, y1 = (int(v) for v in data["boxes"][i])
+            cx0, cy0, cx1, cy1 = (int(v) for v in data["crop_boxes"][i])
+            out.append(
+                {
+                    "segmentation": masks[i],
+                    "area": int(areas[i]),
+                    "bbox": [x0, y0, x1 - x0, y1 - y0],
+                    "predicted_iou": float(data["iou"][i]),
+                    "point_coords": [[float(v) for v in data["points"][i]]],
+                    "stability_score": float(data["stability"][i]),
+                    "crop_box": [cx0, cy0, cx1 - cx0, cy1 - cy0],
+                }
+            )
+        self.timings["post"] += time.perf_counter() - t0
+        return out
+
+    def _process_crop(
+        self, img: np.ndarray, crop_box: list[int], layer: int, orig_size: tuple[int, int]
+    ) -> dict[str, torch.Tensor]:
+        import time
+
+        x0, y0, x1, y1 = crop_box
+        crop = img[y0:y1, x0:x1]
+        ch, cw = crop.shape[:2]
+        pred = self.predictor
+        t0 = time.perf_counter()
+        pred.set_image(crop)
+        fd = pred.fast_decoder()
+        self.timings["encoder"] += time.perf_counter() - t0
+        assert pred.input_size is not None
+        in_h, in_w = pred.input_size
+        lh, lw = needed_lowres(pred.input_size)
+        grid_hw = (math.ceil(lh / 4), math.ceil(lw / 4))
+        vh, vw = math.ceil(in_h / 4), math.ceil(in_w / 4)  # low-res cells covering the image
+        points = self.point_grids[layer] * np.array([[cw, ch]])
+        mask_ids = [1, 2, 3]
+        thr = self.model.mask_threshold
+        orig_h, orig_w = orig_size
+        collected: list[dict[str, torch.Tensor]] = []
+        for i in range(0, len(points), self.points_per_batch):
+            t0 = time.perf_counter()
+            pts = torch.as_tensor(points[i : i + self.points_per_batch], dtype=torch.float32)
+            tp = pred.transform_coords(pts)[:, None, :]
+            sparse, _ = self.model.prompt_encoder((tp, torch.ones(len(pts), 1)), None, None)
+            st = fd.transformer(sparse)
+            iou = st.iou[:, mask_ids]
+            ok = (
+                iou > self.pred_iou_thresh
+                if self.pred_iou_thresh > 0
+                else torch.ones_like(iou, dtype=torch.bool)
+            )
+            prompt_idx = torch.nonzero(ok.any(1)).flatten()
+            self.timings["decoder"] += time.perf_counter() - t0
+            t0 = time.perf_counter()
+            for j in range(0, len(prompt_idx), self.mask_batch):
+                sel = prompt_idx[j : j + self.mask_batch]
+                low = fd.masks(st.select(sel), mask_ids, grid_hw)  # (b, 3, 4gh, 4gw)
+                stab = stability_score(low[..., :vh, :vw], thr, self.stability_score_offset)
+                keep = ok[sel]
+                if self.stability_score_thresh > 0:
+                    keep = keep & (stab >= self.stability_score_thresh)
+                kb, km = torch.nonzero(keep, as_tuple=True)
+                if len(kb) == 0:
+                    continue
+                logits = resize_logits(low[kb, km][:, :lh, :lw], (in_h, in_w), (ch, cw))
+                masks = logits > thr
+                boxes = batched_mask_to_box(masks)
+                part = {
+                    "masks": masks,
+                    "iou": iou[sel[kb], km],
+                    "stability": stab[kb, km],
+                    "points": pts[sel[kb]].double(),
+                    "boxes": boxes,
+                }
+                if crop_box != [0, 0, orig_w, orig_h]:
+                    near = is_box_near_crop_edge(boxes, crop_box, [0, 0, orig_w, orig_h])
+                    part = _filter(part, torch.nonzero(~near).flatten())
+                collected.append(part)
+            self.timings["masks"] += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        data = _cat(collected, (ch, cw))
+        keep = nms(data["boxes"].float(), data["iou"], self.box_nms_thresh)
+        data = _filter(data, keep)
+        data["boxes"] = uncrop_boxes_xyxy(data["boxes"], crop_box)
+        data["points"] = uncrop_points(data["points"], crop_box)
+        data["masks"] = uncrop_masks(data["masks"], crop_box, orig_h, orig_w)
+        data["crop_boxes"] = torch.tensor([crop_box] * len(data["iou"]), dtype=torch.long).view(
+            -1, 4
+        )
+        pred.reset_image()
+        self.timings["post"] += time.perf_counter() - t0
+        return data
+
+    @staticmethod
+    def _postprocess_small_regions(
+        data: dict[str, torch.Tensor], min_area: int, nms_thresh: float
+    ) -> dict[str, torch.Tensor]:
+        """Fill small holes and drop small islands; re-run NMS preferring unchanged masks."""
+        new_masks, scores = [], []
+        for m in data["masks"].cpu().numpy():
+            m, changed_h = remove_small_regions(m, min_area, "holes")
+            m, changed_i = remove_small_regions(m, min_area, "islands")
+            new_masks.append(torch.as_tensor(m))
+            scores.append(0.0 if (changed_h or changed_i) else 1.0)
+        masks = torch.stack(new_masks)
+        boxes = batched_mask_to_box(masks)
+        keep = nms(boxes.float(), torch.as_tensor(scores), nms_thresh)
+        data = dict(data)
+        data["masks"] = masks
+        data["boxes"] = boxes
+        return _filter(data, keep)
+
+
+def _filter(data: dict[str, torch.Tensor], idx: torch.Tensor) -> dict[str, torch.Tensor]:
+    return {k: v[idx] for k, v in data.items()}
+
+
+def _cat(
+    parts: list[dict[str, torch.Tensor]], mask_hw: tuple[int, int] | None = None
+) -> dict[str, torch.Tensor]:
+    if parts:
+        return {k: torch.cat([p[k] for p in parts]) for k in parts[0]}
+    assert mask_hw is not None
+    return {
+        "masks": torch.zeros((0, *mask_hw), dtype=torch.bool),
+        "iou": torch.zeros(0),
+        "stability": torch.zeros(0),
+        "points": torch.zeros((0, 2), dtype=torch.float64),
+        "boxes": torch.zeros((0, 4), dtype=torch.long),
+    }
