@@ -8,6 +8,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from samvg.errors import InputError
 
@@ -39,43 +40,73 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
 
 
-def to_rgb_uint8(
-    image: np.ndarray, background: tuple[int, int, int] = (255, 255, 255)
-) -> np.ndarray:
-    """Convert an image array of any common layout to contiguous uint8 RGB (H, W, 3).
+MIN_SIDE = 2
 
-    Accepts grayscale (H, W) or (H, W, 1), RGB, RGBA (composited over ``background``),
-    uint8, 16-bit integers (scaled by 1/257), bool, and floats in [0, 1].
+
+def to_rgb_uint8(image: np.ndarray | Image.Image) -> np.ndarray:
+    """Return an (H, W, 3) uint8 RGB copy of ``image``.
+
+    Accepts PIL images of any mode and numpy arrays (H, W), (H, W, 1|2|3|4) of dtype uint8,
+    uint16 (or other integers, scaled down from 16 bit when > 255), bool, or float (values in
+    [0, 1], or [0, 255] if any value exceeds 1). Grayscale is replicated to RGB; an alpha
+    channel is composited over white. Raises `InputError` for empty images, images smaller than
+    2x2, non-finite float values, or unsupported shapes.
     """
-    array = np.asarray(image)
-    if array.ndim == 3 and array.shape[2] == 1:
-        array = array[:, :, 0]
-    if array.ndim not in (2, 3) or (array.ndim == 3 and array.shape[2] not in (3, 4)):
-        raise InputError(
-            f"expected an image of shape (H, W), (H, W, 3) or (H, W, 4), got {array.shape}"
-        )
-    if array.shape[0] < 2 or array.shape[1] < 2:
-        raise InputError(f"image is too small ({array.shape[1]}x{array.shape[0]} pixels)")
-    if array.dtype == np.bool_:
-        values = array.astype(np.float64)
-    elif np.issubdtype(array.dtype, np.floating):
-        if not np.all(np.isfinite(array)):
-            raise InputError("image contains NaN or infinite values")
-        values = np.clip(array.astype(np.float64), 0.0, 1.0)
-    elif array.dtype == np.uint8:
-        values = array.astype(np.float64) / 255.0
-    elif np.issubdtype(array.dtype, np.integer):
-        top = 65535.0 if array.max(initial=0) > 255 or array.dtype.itemsize >= 2 else 255.0
-        values = np.clip(array.astype(np.float64) / top, 0.0, 1.0)
+    if isinstance(image, Image.Image):
+        if image.mode in ("I;16", "I;16B", "I;16L", "I;16N", "I", "F"):
+            arr = np.asarray(image)
+        elif image.mode in ("RGBA", "LA", "PA") or (
+            image.mode == "P" and "transparency" in image.info
+        ):
+            arr = np.asarray(image.convert("RGBA"))
+        else:
+            arr = np.asarray(image.convert("RGB"))
     else:
-        raise InputError(f"unsupported image data type {array.dtype}")
-    if values.ndim == 2:
-        values = np.repeat(values[:, :, None], 3, axis=2)
-    if values.shape[2] == 4:
-        alpha = values[:, :, 3:4]
-        back = np.asarray(background, dtype=np.float64) / 255.0
-        values = values[:, :, :3] * alpha + back * (1.0 - alpha)
-    return np.ascontiguousarray(np.round(values * 255.0).astype(np.uint8))
+        arr = np.asarray(image)
+    if arr.ndim == 3 and arr.shape[2] == 1:
+        arr = arr[:, :, 0]
+    if arr.ndim not in (2, 3) or (arr.ndim == 3 and arr.shape[2] not in (2, 3, 4)):
+        raise InputError(f"unsupported image shape {arr.shape}; expected (H, W) or (H, W, 1-4)")
+    h, w = arr.shape[:2]
+    if h == 0 or w == 0:
+        raise InputError(f"image is empty ({h}x{w} pixels)")
+    if h < MIN_SIDE or w < MIN_SIDE:
+        raise InputError(f"image is too small ({w}x{h} pixels); need at least 2x2")
+    x = _to_unit_float(arr) if arr.dtype != np.uint8 else None
+    if x is None:
+        u8 = arr
+        if u8.ndim == 2:
+            return np.repeat(u8[:, :, None], 3, axis=2)
+        if u8.shape[2] == 3:
+            return np.ascontiguousarray(u8)
+        x = u8.astype(np.float32) / 255.0
+    if x.ndim == 2:
+        x = np.repeat(x[:, :, None], 3, axis=2)
+    elif x.shape[2] == 2:
+        x = np.concatenate([np.repeat(x[:, :, :1], 3, axis=2), x[:, :, 1:]], axis=2)
+    if x.shape[2] == 4:
+        alpha = x[:, :, 3:4]
+        x = x[:, :, :3] * alpha + (1.0 - alpha)
+    return np.clip(np.rint(x * 255.0), 0, 255).astype(np.uint8)
+
+
+def _to_unit_float(arr: np.ndarray) -> np.ndarray:
+    """Scale any supported dtype to float32 in [0, 1]."""
+    if arr.dtype == np.bool_:
+        return arr.astype(np.float32)
+    if np.issubdtype(arr.dtype, np.floating):
+        x = arr.astype(np.float32)
+        if not np.isfinite(x).all():
+            raise InputError("image contains NaN or infinite values")
+        if x.size and x.max() > 1.0:
+            x = x / 255.0
+        return np.clip(x, 0.0, 1.0)
+    if np.issubdtype(arr.dtype, np.integer):
+        x = arr.astype(np.float32)
+        if arr.dtype == np.uint16 or (x.size and x.max() > 255):
+            return np.clip(x / 65535.0, 0.0, 1.0)
+        return np.clip(x / 255.0, 0.0, 1.0)
+    raise InputError(f"unsupported image dtype {arr.dtype}")
 
 
 def read_image(path: str | os.PathLike[str]) -> np.ndarray:
@@ -83,7 +114,7 @@ def read_image(path: str | os.PathLike[str]) -> np.ndarray:
 
     Raises :class:`InputError` for a missing, unreadable, corrupt or empty file.
     """
-    from PIL import Image, UnidentifiedImageError
+    from PIL import UnidentifiedImageError
 
     source = Path(path)
     if not source.is_file():
@@ -91,24 +122,22 @@ def read_image(path: str | os.PathLike[str]) -> np.ndarray:
     try:
         with Image.open(source) as opened:
             opened.load()
-            image = opened
-            if image.mode in ("I;16", "I;16B", "I;16L", "I"):
-                array = np.asarray(image, dtype=np.int64).clip(0, 65535).astype(np.uint16)
-            elif image.mode == "F":
-                array = np.asarray(image, dtype=np.float32) / 255.0
-            else:
-                has_alpha = image.mode in ("RGBA", "LA", "PA") or "transparency" in image.info
-                array = np.asarray(image.convert("RGBA" if has_alpha else "RGB"))
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as error:
+            return to_rgb_uint8(opened)
+    except (
+        UnidentifiedImageError,
+        Image.DecompressionBombError,
+        OSError,
+        SyntaxError,
+        ValueError,
+    ) as error:
+        if isinstance(error, InputError):
+            raise
         raise InputError(f"cannot read image {source}: {error}") from None
-    return to_rgb_uint8(array)
 
 
 def write_png(path: str | os.PathLike[str], image: np.ndarray) -> None:
     """Write an (H, W, 3) image (uint8, or float in [0, 1]) as PNG, atomically."""
     import io
-
-    from PIL import Image
 
     array = np.asarray(image)
     if np.issubdtype(array.dtype, np.floating):

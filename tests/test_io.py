@@ -35,7 +35,7 @@ def test_arrays_of_floats_and_bools_convert():
     with pytest.raises(InputError, match="too small"):
         to_rgb_uint8(np.zeros((1, 1, 3), np.uint8))
     with pytest.raises(InputError, match="shape"):
-        to_rgb_uint8(np.zeros((4, 4, 2), np.uint8))
+        to_rgb_uint8(np.zeros((4, 4, 5), np.uint8))
 
 
 def test_corrupt_missing_and_truncated_files_are_clear_errors(tmp_path):

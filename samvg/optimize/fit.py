@@ -4,7 +4,8 @@ differentiable rasterizer.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +22,21 @@ class FitResult:
     points: np.ndarray
     colours: np.ndarray
     losses: list[float]
+
+
+@contextlib.contextmanager
+def single_torch_thread() -> Iterator[None]:
+    """Run torch on one thread inside the block.
+
+    The per-step tensors are small: a thread pool costs more than it saves, and it slows down
+    badly whenever another process holds one of the cores.
+    """
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(threads)
 
 
 def fit_paths(
@@ -52,17 +68,20 @@ def fit_paths(
                 {"params": [colour_tensor], "lr": colour_learning_rate},
             ]
         )
-        for step in range(steps):
-            optimizer.zero_grad(set_to_none=True)
-            rendered = rasterize(point_tensor, colour_tensor, width, height, background=background)
-            loss = torch.mean((rendered - target_tensor) ** 2)
-            loss.backward()
-            optimizer.step()
-            with torch.no_grad():
-                colour_tensor.clamp_(0.0, 1.0)
-            losses.append(float(loss))
-            if on_step is not None:
-                on_step(step, losses[-1])
+        with single_torch_thread():
+            for step in range(steps):
+                optimizer.zero_grad(set_to_none=True)
+                rendered = rasterize(
+                    point_tensor, colour_tensor, width, height, background=background
+                )
+                loss = torch.mean((rendered - target_tensor) ** 2)
+                loss.backward()
+                optimizer.step()
+                with torch.no_grad():
+                    colour_tensor.clamp_(0.0, 1.0)
+                losses.append(float(loss))
+                if on_step is not None:
+                    on_step(step, losses[-1])
     return FitResult(
         points=point_tensor.detach().numpy().astype(np.float64),
         colours=colour_tensor.detach().numpy().astype(np.float64),
