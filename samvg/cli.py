@@ -102,7 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
     vectorize.add_argument("--preview", type=Path, help="also write a PNG render of the result")
     vectorize.add_argument("--model", default="mobile_sam", help="SAM variant (default mobile_sam)")
     vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
-    vectorize.add_argument("--steps", type=int, default=100, help="optimisation steps")
+    vectorize.add_argument("--steps", type=int, default=300, help="optimisation steps")
     vectorize.add_argument("--max-paths", type=int, default=64)
     vectorize.add_argument("--segments", type=int, default=5, help="cubic segments per path")
     vectorize.add_argument("--precision", type=int, default=2, help="decimals in SVG output")

@@ -25,7 +25,7 @@ class VectorizeConfig:
     num_segments: int = 5
     max_paths: int = 64
     min_area_fraction: float = 0.0005
-    steps: int = 100
+    steps: int = 300
     max_side: int = 512
 
 

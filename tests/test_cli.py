@@ -98,5 +98,6 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
     assert (result.width, result.height) == (512, 280)
     assert 5 <= len(result.paths) <= 64
     mse = float(np.mean((result.render() - target) ** 2))
-    assert mse < 0.01, mse
+    flat_fill_mse = float(np.mean((target - target.mean(axis=(0, 1))) ** 2))
+    assert mse < 0.02 and mse < flat_fill_mse / 3, (mse, flat_fill_mse)
     assert read_image(preview).shape == target.shape

@@ -43,8 +43,8 @@ def fit_paths(
     points: np.ndarray,
     colours: np.ndarray,
     target: np.ndarray,
-    steps: int = 100,
-    point_learning_rate: float = 0.5,
+    steps: int = 300,
+    point_learning_rate: float = 1.0,
     colour_learning_rate: float = 0.01,
     background: tuple[float, float, float] = (1.0, 1.0, 1.0),
     on_step: Callable[[int, float], None] | None = None,
@@ -79,7 +79,7 @@ def fit_paths(
                 optimizer.step()
                 with torch.no_grad():
                     colour_tensor.clamp_(0.0, 1.0)
-                losses.append(float(loss))
+                losses.append(float(loss.detach()))
                 if on_step is not None:
                     on_step(step, losses[-1])
     return FitResult(
