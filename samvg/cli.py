@@ -10,6 +10,11 @@ from pathlib import Path
 from samvg.errors import SamvgError
 
 
+def _say(console, text: str) -> None:  # type: ignore[no-untyped-def]
+    """Print plain text (no markup, no wrapping: paths stay on one line)."""
+    console.print(text, markup=False, highlight=False, soft_wrap=True)
+
+
 def _progress_reporter(console):  # type: ignore[no-untyped-def]
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -57,10 +62,10 @@ def _vectorize(arguments: argparse.Namespace, console) -> None:  # type: ignore[
     with progress:
         result = vectorize(image, config, progress=report)
     result.save(arguments.output, precision=arguments.precision)
-    console.print(f"wrote {arguments.output} ({len(result.paths)} paths)", markup=False)
+    _say(console, f"wrote {arguments.output} ({len(result.paths)} paths)")
     if arguments.preview is not None:
         write_png(arguments.preview, result.render())
-        console.print(f"wrote {arguments.preview}")
+        _say(console, f"wrote {arguments.preview}")
 
 
 def _segment(arguments: argparse.Namespace, console) -> None:  # type: ignore[no-untyped-def]
@@ -78,7 +83,7 @@ def _segment(arguments: argparse.Namespace, console) -> None:  # type: ignore[no
     for mask in masks:
         overlay[mask] = 0.45 * overlay[mask] + 0.55 * rng.uniform(0, 1, 3)
     write_png(arguments.output, overlay)
-    console.print(f"wrote {arguments.output} ({len(masks)} masks)")
+    _say(console, f"wrote {arguments.output} ({len(masks)} masks)")
 
 
 def _render(arguments: argparse.Namespace, console) -> None:  # type: ignore[no-untyped-def]
@@ -88,7 +93,7 @@ def _render(arguments: argparse.Namespace, console) -> None:  # type: ignore[no-
     _check_output(arguments.output, (".png",))
     image = VectorImage.load(arguments.input)
     write_png(arguments.output, image.render(scale=arguments.scale))
-    console.print(f"wrote {arguments.output}")
+    _say(console, f"wrote {arguments.output}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -132,7 +137,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         arguments.handler(arguments, console)
     except SamvgError as error:
-        console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False)
+        console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, soft_wrap=True)
         return 1
     except KeyboardInterrupt:
         console.print("interrupted")

@@ -89,7 +89,7 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
             "--checkpoint",
             str(sam_checkpoint),
             "--steps",
-            "30",
+            "150",
         ]
     )
     assert code == 0
