@@ -158,3 +158,18 @@ def test_save_is_atomic(tmp_path, monkeypatch):
 def test_load_missing_file_is_a_clear_error(tmp_path):
     with pytest.raises(InputError, match="not found"):
         VectorImage.load(tmp_path / "missing.svg")
+
+
+def test_real_svg_renders_like_resvg(bench_dir):
+    import io
+
+    import resvg_py
+    from PIL import Image
+
+    source = bench_dir / "emoji" / "twemoji_rainbow.svg"
+    image = VectorImage.load(source)
+    ours = image.render(scale=512 / image.width)
+    png = resvg_py.svg_to_bytes(svg_path=str(source), width=512, height=512, background="#ffffff")
+    theirs = np.asarray(Image.open(io.BytesIO(bytes(png))).convert("RGB"), np.float32) / 255.0
+    assert ours.shape == theirs.shape == (512, 512, 3)
+    assert np.abs(ours - theirs).mean() <= 1 / 255
