@@ -12,6 +12,16 @@ SUPERSAMPLE = 16
 
 
 # ------------------------------------------------------------------------------------ scenes
+def rectangle(x0: float, y0: float, x1: float, y1: float) -> np.ndarray:
+    """Axis-aligned rectangle as a closed path of four straight cubics (controls at thirds)."""
+    corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
+    points = []
+    for i in range(4):
+        start, end = corners[i], corners[(i + 1) % 4]
+        points += [start, start + (end - start) / 3, start + 2 * (end - start) / 3]
+    return np.array(points)
+
+
 def blob(rng: np.random.Generator, cx: float, cy: float, r: float, k: int = 4) -> np.ndarray:
     """Star-shaped closed path of ``k`` cubic segments around (cx, cy), radius about ``r``."""
     ang = np.sort(rng.uniform(0, 2 * np.pi, 3 * k))

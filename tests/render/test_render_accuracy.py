@@ -7,6 +7,7 @@ import torch
 from render_reference import (
     blob,
     random_scene,
+    rectangle,
     resvg_render,
     supersampled_render,
     svg_text,
@@ -89,23 +90,7 @@ def test_exact_area_of_polygon_pixels():
 
 
 def test_translucent_overlap_is_straight_alpha_over():
-    square = np.array(
-        [
-            [2, 2],
-            [4, 2],
-            [6, 2],
-            [8, 2],
-            [8, 4],
-            [8, 6],
-            [8, 8],
-            [6, 8],
-            [4, 8],
-            [2, 8],
-            [2, 6],
-            [2, 4],
-        ],
-        dtype=np.float64,
-    )
+    square = rectangle(2, 2, 8, 8)
     colors = np.array([[1.0, 0.0, 0.0, 0.5], [0.0, 0.0, 1.0, 0.25]])
     image = render(np.stack([square, square]), colors, 10, 10)
     under = np.array([1.0, 0.5, 0.5])  # red at 50 % over white
@@ -113,23 +98,7 @@ def test_translucent_overlap_is_straight_alpha_over():
     np.testing.assert_allclose(image[5, 5], expected, atol=1e-12)
     np.testing.assert_allclose(image[0, 0], [1, 1, 1], atol=1e-12)
     # Edge pixels: alpha applied once, times coverage (half-covered pixel at x = 1.5).
-    half = np.array(
-        [
-            [1.5, 2],
-            [4, 2],
-            [6, 2],
-            [8, 2],
-            [8, 4],
-            [8, 6],
-            [8, 8],
-            [6, 8],
-            [4, 8],
-            [1.5, 8],
-            [1.5, 6],
-            [1.5, 4],
-        ],
-        dtype=np.float64,
-    )
+    half = rectangle(1.5, 2, 8, 8)
     edge = render(half[None], colors[:1], 10, 10)[5, 1]
     np.testing.assert_allclose(edge, [1.0, 0.75, 0.75], atol=1e-12)
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 import torch
-from render_reference import blob, random_scene
+from render_reference import blob, random_scene, rectangle
 
 from samvg.render import rasterize
 
@@ -73,23 +73,7 @@ def test_colour_gradients_are_exact():
 
 
 def test_colour_gradient_closed_form():
-    square = np.array(
-        [
-            [2, 2],
-            [4, 2],
-            [6, 2],
-            [8, 2],
-            [8, 4],
-            [8, 6],
-            [8, 8],
-            [6, 8],
-            [4, 8],
-            [2, 8],
-            [2, 6],
-            [2, 4],
-        ],
-        dtype=np.float64,
-    )[None]
+    square = rectangle(2, 2, 8, 8)[None]
     colors = torch.tensor([[0.2, 0.3, 0.4, 0.5]], requires_grad=True)
     image = rasterize(torch.tensor(square), colors, 10, 10, background=(1.0, 1.0, 1.0))
     image[..., 0].sum().backward()
