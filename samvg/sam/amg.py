@@ -16,7 +16,7 @@ from samvg.sam.amg_utils import (
     is_box_near_crop_edge,
     nms,
     remove_small_regions,
-    stability_score,
+    stability_from_counts,
     uncrop_boxes_xyxy,
     uncrop_masks,
     uncrop_points,
@@ -32,8 +32,9 @@ class SamAutomaticMaskGenerator:
     Same parameters and output as upstream SAM's generator (binary-mask output). Speed: per
     crop the image is encoded once, prompts run in batches through `FastDecoder`; masks whose
     predicted IoU is below ``pred_iou_thresh`` are never computed, the stability score is
-    taken on the 256x256 low-res logits (the part covering the image), and only survivors are
-    upsampled, straight to the crop's own resolution. NMS runs in torch.
+    taken on the 256x256 low-res logits (the part covering the image; counted while the logits
+    are laid out, `FastDecoder.masks_and_counts`), and only survivors are upsampled, straight
+    to the crop's own resolution. NMS runs in torch.
 
     Differences from upstream (documented, deliberate): stability is measured on low-res
     logits rather than on logits upsampled to the image size, and masks are resampled from
@@ -171,8 +172,11 @@ class SamAutomaticMaskGenerator:
             t0 = time.perf_counter()
             for j in range(0, len(prompt_idx), self.mask_batch):
                 sel = prompt_idx[j : j + self.mask_batch]
-                low = fd.masks(st.select(sel), mask_ids, grid_hw)  # (b, 3, 4gh, 4gw)
-                stab = stability_score(low[..., :vh, :vw], thr, self.stability_score_offset)
+                off = self.stability_score_offset
+                low, cnt = fd.masks_and_counts(  # (b, 3, 4gh, 4gw) logits, (b, 3, 2) counts
+                    st.select(sel), mask_ids, grid_hw, (vh, vw), thr + off, thr - off
+                )
+                stab = stability_from_counts(cnt[..., 0], cnt[..., 1])
                 keep = ok[sel]
                 if self.stability_score_thresh > 0:
                     keep = keep & (stab >= self.stability_score_thresh)

@@ -135,6 +135,11 @@ def stability_score(logits: torch.Tensor, threshold: float, offset: float) -> to
     """IoU between the masks thresholded at threshold +/- offset, per mask (..., H, W)."""
     inter = (logits > threshold + offset).sum((-1, -2), dtype=torch.int64)
     union = (logits > threshold - offset).sum((-1, -2), dtype=torch.int64)
+    return stability_from_counts(inter, union)
+
+
+def stability_from_counts(inter: torch.Tensor, union: torch.Tensor) -> torch.Tensor:
+    """Stability score from counts of logits above the high and the low threshold."""
     return torch.where(union > 0, inter.float() / union.clamp(min=1).float(), torch.zeros(()))
 
 

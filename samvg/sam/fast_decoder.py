@@ -15,7 +15,13 @@ factored as per-head prompt values (B, H, T, 16) times shared (128 x 256) weight
 
 Only the second transposed convolution, its GELUs and the hypernetwork dot products run per
 prompt at full size, and only for the prompts that need masks (`masks`), restricted to the
-part of the 64x64 grid that covers the image (the rest is padding).
+part of the 64x64 grid that covers the image (the rest is padding). `masks_and_counts` also
+counts the logits above the stability thresholds while laying them out (`_kernels`).
+
+Layout: per-prompt attention weights and coefficients are kept transposed, ``(B, r, N)`` with
+the 4096 image tokens contiguous, so softmaxes over the few prompt tokens run along a strided
+axis of contiguous rows (fast) and low-rank products are plain batched GEMMs; shared key
+matrices are stored pre-transposed and concatenated (``[Z, K_const]``) once per image.
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ from dataclasses import dataclass
 import torch
 import torch.nn.functional as F
 
+from samvg.sam._kernels import scatter_logits_counts
 from samvg.sam.model import Sam
 from samvg.sam.transformer import Attention
 
@@ -58,7 +65,7 @@ class DecoderState:
     hyper: torch.Tensor  # (B, 4, 32) hypernetwork outputs of all 4 mask tokens
     s1: torch.Tensor  # (B, N) 1/std of the first image LayerNorm
     s2: torch.Tensor  # (B, N) 1/std of the second image LayerNorm
-    d: torch.Tensor  # (B, N, r) low-rank coefficients of the image tokens
+    d: torch.Tensor  # (B, r, N) low-rank coefficients of the image tokens, transposed
     vt1: torch.Tensor  # (B, H, T, dh) values of the first image->token attention
     vt2: torch.Tensor  # (B, H, T, dh) values of the second image->token attention
 
@@ -110,11 +117,11 @@ class FastDecoder:
         self.v0 = _heads(_lin(s0, a.v_proj), h)
         # layer 0, image -> token: image queries are shared
         a = l0.cross_attn_image_to_token
-        self.q1 = _heads(_lin(s0 + p, a.q_proj), h) * sc(a)
+        self.q1t = (_heads(_lin(s0 + p, a.q_proj), h) * sc(a)).transpose(1, 2).contiguous()
         wo1, bo1 = a.out_proj.weight, a.out_proj.bias  # (C, 128)
         y1c = _center(s0 + bo1)
         self.y1_sq = (y1c * y1c).sum(1)
-        self.e1 = _heads(y1c @ wo1, h)  # (H, N, dh): Y1c . U1 rows
+        self.e1t = _heads(y1c @ wo1, h).transpose(1, 2).contiguous()  # (H, dh, N): Y1c . U1
         m1c = _center(wo1.t())  # (128, C) factored basis of U1, centred along C
         self.m1c = m1c
         self.gram1 = m1c @ m1c.t()  # (128, 128)
@@ -124,8 +131,9 @@ class FastDecoder:
         m1 = m1c * g1
         # layer 1, token -> image
         a = l1.cross_attn_token_to_image
-        self.zk2 = _heads(F.linear(yb1, a.k_proj.weight), h)
-        self.kc2 = _heads(_lin(p + b1, a.k_proj), h)
+        zk2 = _heads(F.linear(yb1, a.k_proj.weight), h)
+        self.zkc2 = torch.cat([zk2, _heads(_lin(p + b1, a.k_proj), h)], 1).transpose(1, 2)
+        self.zkc2 = self.zkc2.contiguous()  # (H, d, 2N): shared and constant key parts
         self.m1k = m1 @ a.k_proj.weight.t()
         self.zv2 = _heads(F.linear(yb1, a.v_proj.weight), h)
         self.vc2 = _lin(b1, a.v_proj).view(h, 1, -1)
@@ -133,8 +141,9 @@ class FastDecoder:
         # layer 1, image -> token
         a = l1.cross_attn_image_to_token
         s = sc(a)
-        self.zq3 = _heads(F.linear(yb1, a.q_proj.weight), h) * s
-        self.qc3 = _heads(_lin(p + b1, a.q_proj), h) * s
+        zq3 = _heads(F.linear(yb1, a.q_proj.weight), h) * s
+        qc3 = _heads(_lin(p + b1, a.q_proj), h) * s
+        self.zqc3 = torch.cat([zq3, qc3], 1).transpose(1, 2).contiguous()  # (H, d, 2N)
         self.m1q = (m1 @ a.q_proj.weight.t()) * s
         wo3, bo3 = a.out_proj.weight, a.out_proj.bias
         # second LayerNorm: x2 = s1*yb1 + (s1*A1) R1 + A2 R2 + (b1 + bo3)
@@ -145,7 +154,7 @@ class FastDecoder:
         cc = _center(b1 + bo3)
         self.basis = torch.cat([m1cc, m2c], 0)  # (256, C): rows of R1 (first 128), R2 (last)
         self.cc = cc
-        self.e2 = _heads(yb1c @ self.basis.t(), h * 2)  # (2H, N, dh)
+        self.e2t = _heads(yb1c @ self.basis.t(), h * 2).transpose(1, 2).contiguous()
         self.y_cc = yb1c @ cc
         g2, b2 = l1.norm4.weight, l1.norm4.bias
         self.eps2 = l1.norm4.eps
@@ -156,8 +165,9 @@ class FastDecoder:
         basis2 = torch.cat([self.basis, cc[None]], 0) * g2  # (257, C)
         self.basis2 = basis2
         # final token -> image attention
-        self.zkf = _heads(F.linear(y2, fa.k_proj.weight), h)
-        self.kcf = _heads(_lin(p + b2, fa.k_proj), h)
+        zkf = _heads(F.linear(y2, fa.k_proj.weight), h)
+        self.zkcf = torch.cat([zkf, _heads(_lin(p + b2, fa.k_proj), h)], 1).transpose(1, 2)
+        self.zkcf = self.zkcf.contiguous()
         self.mkf = basis2 @ fa.k_proj.weight.t()  # (257, 128)
         self.zvf = _heads(F.linear(y2, fa.v_proj.weight), h)
         self.vcf = _lin(b2, fa.v_proj).view(h, 1, -1)
@@ -190,37 +200,38 @@ class FastDecoder:
         q: torch.Tensor,
         scale: torch.Tensor,
         inner: torch.Tensor | None,
-        z_k: torch.Tensor,
-        d: torch.Tensor,
+        zkc_t: torch.Tensor,
+        d_t: torch.Tensor,
         r_k: torch.Tensor,
-        kc: torch.Tensor,
         z_v: torch.Tensor,
         r_v: torch.Tensor,
         vc: torch.Tensor,
     ) -> torch.Tensor:
         """Token->image attention on image tokens ``s*(inner*Z + D R) + const``.
 
-        q (B, H, T, d) already scaled; scale = s (B, N); inner (B, N) or None; z_* (H, N, d)
-        shared; d (B, N, r); r_* (B, r, H*d) per prompt; kc (H, N, d) shared; vc (H, 1, d).
+        q (B, H, T, d) already scaled; scale = s (B, N); inner (B, N) or None; zkc_t
+        (H, d, 2N) shared key parts ``[Z_k, K_const]`` transposed; d_t (B, r, N) = D^T;
+        r_* (B, r, H*d) per prompt; z_v (H, N, d) shared; vc (H, 1, d).
         """
         b, h, t, dd = q.shape
-        n = z_k.shape[1]
+        n = zkc_t.shape[2] // 2
         qh = q.transpose(0, 1).reshape(h, b * t, dd)
-        zk = torch.cat([z_k, kc], dim=1)  # (H, 2N, d)
-        both = (qh @ zk.transpose(1, 2)).view(h, b, t, 2, n).permute(1, 0, 2, 3, 4)
-        a_sh, a_c = both[:, :, :, 0], both[:, :, :, 1]
-        if inner is not None:
-            a_sh = a_sh * inner[:, None, None, :]
-        # (B, H, T, r) = q_h . r_k,h
+        both = torch.matmul(qh, zkc_t).view(h, b, t, 2, n)  # (H, B, T, 2, N)
+        a_sh = both[:, :, :, 0].transpose(0, 1)  # (B, H, T, N) views
+        a_c = both[:, :, :, 1].transpose(0, 1)
+        # (B, H, T, r) = q_h . r_k,h ; logits laid out (B, H*T, N), softmax over contiguous N
         qr = torch.matmul(q, r_k.view(b, -1, h, dd).permute(0, 2, 3, 1))
-        a_lr = torch.bmm(qr.reshape(b, h * t, -1), d.transpose(1, 2)).view(b, h, t, n)
-        logits = (a_sh + a_lr) * scale[:, None, None, :] + a_c
-        att = torch.softmax(logits, dim=-1)
-        att_s = att * scale[:, None, None, :]
+        lg = torch.bmm(qr.reshape(b, h * t, -1), d_t).view(b, h, t, n)
+        if inner is not None:
+            lg.addcmul_(a_sh, inner[:, None, None, :])
+        else:
+            lg.add_(a_sh)
+        lg.mul_(scale[:, None, None, :]).add_(a_c)
+        att_s = torch.softmax(lg, dim=-1).mul_(scale[:, None, None, :])
+        pd = torch.bmm(att_s.view(b, h * t, n), d_t.transpose(1, 2)).view(b, h, t, -1)
         w_sh = att_s * inner[:, None, None, :] if inner is not None else att_s
         o_sh = torch.matmul(w_sh.transpose(0, 1).reshape(h, b * t, n), z_v)
         o_sh = o_sh.view(h, b, t, dd).transpose(0, 1)
-        pd = torch.bmm(att_s.reshape(b, h * t, n), d).view(b, h, t, -1)
         o_lr = torch.matmul(pd, r_v.view(b, -1, h, dd).transpose(1, 2))
         return o_sh + o_lr + vc
 
@@ -233,6 +244,7 @@ class FastDecoder:
         b = sparse.shape[0]
         tok = torch.cat([md.output_tokens().unsqueeze(0).expand(b, -1, -1), sparse], dim=1)
         t = tok.shape[1]
+        ht = h * t
         pe = tok
         # ---- layer 0 (no PE in the self attention, its output replaces the tokens)
         q = l0.norm1(l0.self_attn(tok, tok, tok))
@@ -245,15 +257,15 @@ class FastDecoder:
         kt = _heads(_lin(q + pe, a.k_proj), h)  # (B, H, T, d)
         vt1 = _heads(_lin(q, a.v_proj), h)
         n = self.n
-        # image->token logits (B, N, H, T); image queries shared
-        lg = torch.matmul(self.q1.unsqueeze(0), kt.transpose(2, 3))  # (B, H, N, T)
-        a1 = torch.softmax(lg, dim=-1).permute(0, 2, 1, 3).reshape(b, n, h * t)
+        # image->token logits (H, B, T, N) (image queries shared); weights A1^T (B, HT, N)
+        lg = torch.matmul(kt.transpose(0, 1).reshape(h, b * t, -1), self.q1t).view(h, b, t, n)
+        a1 = torch.softmax(lg.transpose(0, 1), dim=2).reshape(b, ht, n)
         # LayerNorm statistics of x1 = Y1 + A1 U1
-        cross = torch.matmul(self.e1.unsqueeze(0), vt1.transpose(2, 3))  # (B, H, N, T)
-        cross = (cross.permute(0, 2, 1, 3).reshape(b, n, h * t) * a1).sum(-1)
+        cross = torch.matmul(vt1.transpose(0, 1).reshape(h, b * t, -1), self.e1t)
+        cross = (cross.view(h, b, t, n).transpose(0, 1) * a1.view(b, h, t, n)).sum((1, 2))
         u1 = _factor(vt1, self.m1c)  # (B, HT, C) centred rows of U1
         g = torch.bmm(u1, u1.transpose(1, 2))
-        quad = (torch.bmm(a1, g) * a1).sum(-1)
+        quad = (torch.bmm(g, a1) * a1).sum(1)
         c = self.y2.shape[1]
         var1 = (self.y1_sq + 2 * cross + quad) / c
         s1 = torch.rsqrt(var1 + self.eps1)
@@ -266,10 +278,9 @@ class FastDecoder:
             qq,
             s1,
             None,
-            self.zk2,
+            self.zkc2,
             a1,
             _factor(vt1, self.m1k),
-            self.kc2,
             self.zv2,
             _factor(vt1, self.m1v),
             self.vc2,
@@ -279,25 +290,24 @@ class FastDecoder:
         a = l1.cross_attn_image_to_token
         kt = _heads(_lin(q + pe, a.k_proj), h)
         vt2 = _heads(_lin(q, a.v_proj), h)
-        # logits (B, H, N, T) = s1 * (Zq kt + A1 (R1q kt)) + Qc kt
-        kt_all = kt.transpose(0, 1).reshape(h, b * t, -1).transpose(1, 2)  # (H, d, BT)
-        lz = torch.matmul(self.zq3, kt_all).view(h, n, b, t).permute(2, 0, 1, 3)
-        lc = torch.matmul(self.qc3, kt_all).view(h, n, b, t).permute(2, 0, 1, 3)
-        r1q = _factor(vt1, self.m1q).view(b, h * t, h, -1).transpose(1, 2)  # (B, H, HT, d)
+        # logits (B, H, T, N) = s1 * (Zq kt + A1 (R1q kt)) + Qc kt
+        lzc = torch.matmul(kt.transpose(0, 1).reshape(h, b * t, -1), self.zqc3)
+        lzc = lzc.view(h, b, t, 2, n)
+        r1q = _factor(vt1, self.m1q).view(b, ht, h, -1).transpose(1, 2)  # (B, H, HT, d)
         rk = torch.matmul(r1q, kt.transpose(2, 3))  # (B, H, HT, T)
-        llr = torch.bmm(a1, rk.permute(0, 2, 1, 3).reshape(b, h * t, h * t))
-        llr = llr.view(b, n, h, t).permute(0, 2, 1, 3)
-        lg = (lz + llr) * s1[:, None, :, None] + lc
-        a2 = torch.softmax(lg, dim=-1).permute(0, 2, 1, 3).reshape(b, n, h * t)
-        # second LayerNorm: x2c = s1*Yc + D' R' with D' = [s1*A1, A2, 1]
-        d = torch.cat([a1 * s1[:, :, None], a2], dim=2)  # (B, N, 2HT)
+        lg = torch.bmm(rk.transpose(2, 3).reshape(b, ht, ht), a1).view(b, h, t, n)
+        lg.add_(lzc[:, :, :, 0].transpose(0, 1)).mul_(s1[:, None, None, :])
+        lg.add_(lzc[:, :, :, 1].transpose(0, 1))
+        a2 = torch.softmax(lg, dim=2).view(b, ht, n)
+        # second LayerNorm: x2c = s1*Yc + D' R' with D'^T = [s1*A1; A2; 1] (B, 2HT+1, N)
+        d = torch.cat([a1 * s1[:, None, :], a2, torch.ones_like(a2[:, :1])], dim=1)
         vt12 = torch.cat([vt1, vt2], dim=1)  # (B, 2H, T, d)
-        cross = torch.matmul(self.e2.unsqueeze(0), vt12.transpose(2, 3))  # (B, 2H, N, T)
-        cross = (cross.permute(0, 2, 1, 3).reshape(b, n, 2 * h * t) * d).sum(-1) + self.y_cc
+        cross = torch.matmul(vt12.transpose(0, 1).reshape(2 * h, b * t, -1), self.e2t)
+        cross = cross.view(2 * h, b, t, n).transpose(0, 1) * d[:, : 2 * ht].view(b, 2 * h, t, n)
+        cross = cross.sum((1, 2)) + self.y_cc
         r = torch.cat([_factor(vt12, self.basis), self.cc.expand(b, 1, -1)], dim=1)  # (B, 2HT+1, C)
         g = torch.bmm(r, r.transpose(1, 2))
-        dq = torch.bmm(d, g[:, :-1, :-1])
-        quad = (dq * d).sum(-1) + 2 * torch.bmm(d, g[:, :-1, -1:]).squeeze(-1) + g[:, -1, -1:]
+        quad = (torch.bmm(g, d) * d).sum(1)
         var2 = (s1 * s1 * self.yb1c_sq + 2 * s1 * cross + quad) / c
         s2 = torch.rsqrt(var2 + self.eps2)
         # ---- final token -> image attention
@@ -307,20 +317,55 @@ class FastDecoder:
         qf = _heads(_lin(q + pe, fa.q_proj), h) / math.sqrt(fa.internal_dim // h)
         rkf = self._basis_rows(vt12, self.mkf)
         rvf = self._basis_rows(vt12, self.mvf)
-        d1 = torch.cat([d, torch.ones_like(d[:, :, :1])], dim=2)
-        o = self._t2i_lowrank(qf, s2, s1, self.zkf, d1, rkf, self.kcf, self.zvf, rvf, self.vcf)
+        o = self._t2i_lowrank(qf, s2, s1, self.zkcf, d, rkf, self.zvf, rvf, self.vcf)
         q = tr.norm_final_attn(q + fa.out_proj(o.transpose(1, 2).reshape(b, k_out, -1)))
         iou = md.iou_prediction_head(q[:, 0, :])
         mt = q[:, 1 : 1 + md.num_mask_tokens, :]
         hyper = torch.stack(
             [mlp(mt[:, i, :]) for i, mlp in enumerate(md.output_hypernetworks_mlps)], dim=1
         )
-        return DecoderState(iou, hyper, s1, s2, d1, vt1, vt2)
+        return DecoderState(iou, hyper, s1, s2, d, vt1, vt2)
 
     def _basis_rows(self, vt12: torch.Tensor, m: torch.Tensor) -> torch.Tensor:
         """Rows of R' mapped by a shared matrix: m (257, X) -> (B, 2HT+1, X)."""
         b = vt12.shape[0]
         return torch.cat([_factor(vt12, m[:-1]), m[-1:].expand(b, 1, -1)], dim=1)
+
+    def _cell_logits(
+        self,
+        state: DecoderState,
+        mask_ids: list[int] | torch.Tensor,
+        grid_hw: tuple[int, int] | None,
+    ) -> torch.Tensor:
+        """Mask logits per grid cell: (B, gh, gw, 2, 2, 2, 2, M), see `_kernels`."""
+        gh, gw = grid_hw if grid_hw is not None else self.grid
+        b = state.s1.shape[0]
+        nv = gh * gw
+        full = (gh, gw) == self.grid
+        if full:
+            d, s1, s2, yt = state.d, state.s1, state.s2, self.yt
+        else:
+            gy, gx = self.grid
+
+            def crop(x: torch.Tensor) -> torch.Tensor:
+                return x.reshape(*x.shape[:-1], gy, gx)[..., :gh, :gw].reshape(*x.shape[:-1], nv)
+
+            d, s1, s2 = crop(state.d), crop(state.s1), crop(state.s2)
+            yt = crop(self.yt.t()).t()
+        vt12 = torch.cat([state.vt1, state.vt2], dim=1)
+        rt = self._basis_rows(vt12, self.mt)  # (B, r+1, 4*C4)
+        x = torch.baddbmm(yt.unsqueeze(0) * s1[:, :, None], d.transpose(1, 2), rt)
+        x.mul_(s2[:, :, None]).add_(self.ct)  # (B, Nv, 4*C4), first transposed conv output
+        c4 = self.c4
+        x = F.layer_norm(
+            x.view(b, nv * 4, c4), (c4,), self.ln_up.weight, self.ln_up.bias, self.ln_up.eps
+        )
+        x = F.gelu(x)
+        z = torch.addmm(self.bt2, x.view(-1, c4), self.wt2)  # (B*Nv*4, 4*C8)
+        z = torch.ops.aten.gelu_(z).view(b, nv * 16, self.c8)
+        hyper = state.hyper[:, list(mask_ids) if not torch.is_tensor(mask_ids) else mask_ids]
+        m = torch.bmm(z, hyper.transpose(1, 2))  # (B, Nv*16, M)
+        return m.view(b, gh, gw, 2, 2, 2, 2, m.shape[-1])
 
     def masks(
         self,
@@ -333,32 +378,30 @@ class FastDecoder:
         Only the top-left ``grid_hw`` cells of the 64x64 embedding grid are upscaled (the rest
         covers padding); default: the whole grid (256x256 logits).
         """
-        gh, gw = grid_hw if grid_hw is not None else self.grid
-        b = state.s1.shape[0]
-        n_full = self.n
-        rows = torch.arange(gh)[:, None] * self.grid[1] + torch.arange(gw)[None, :]
-        sel = rows.flatten()
-        nv = sel.numel()
-        full = nv == n_full
-        d = state.d if full else state.d[:, sel]
-        s1 = state.s1 if full else state.s1[:, sel]
-        s2 = state.s2 if full else state.s2[:, sel]
-        yt = self.yt if full else self.yt[sel]
-        vt12 = torch.cat([state.vt1, state.vt2], dim=1)
-        rt = self._basis_rows(vt12, self.mt)  # (B, r+1, 4*C4)
-        x = torch.baddbmm(yt.unsqueeze(0) * s1[:, :, None], d, rt)
-        x = x * s2[:, :, None] + self.ct  # (B, Nv, 4*C4), first transposed conv output
-        c4 = self.c4
-        x = x.view(b, nv, 4, c4)
-        x = F.layer_norm(x, (c4,), None, None, self.ln_up.eps)
-        x = F.gelu(x * self.ln_up.weight + self.ln_up.bias)
-        z = torch.matmul(x, self.wt2) + self.bt2  # (B, Nv, 4, 4*C8)
-        z = F.gelu(z).view(b, nv * 16, self.c8)
-        hyper = state.hyper[:, list(mask_ids) if not torch.is_tensor(mask_ids) else mask_ids]
-        m = torch.bmm(z, hyper.transpose(1, 2))  # (B, Nv*16, M)
-        nm = m.shape[-1]
-        m = m.view(b, gh, gw, 2, 2, 2, 2, nm).permute(0, 7, 1, 3, 5, 2, 4, 6)
+        m = self._cell_logits(state, mask_ids, grid_hw)
+        b, gh, gw, nm = m.shape[0], m.shape[1], m.shape[2], m.shape[-1]
+        m = m.permute(0, 7, 1, 3, 5, 2, 4, 6)
         return m.reshape(b, nm, 4 * gh, 4 * gw)
+
+    def masks_and_counts(
+        self,
+        state: DecoderState,
+        mask_ids: list[int] | torch.Tensor,
+        grid_hw: tuple[int, int] | None,
+        valid_hw: tuple[int, int],
+        hi: float,
+        lo: float,
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """`masks` plus counts (B, M, 2) of logits > ``hi`` and > ``lo`` in the top-left
+        ``valid_hw`` low-res pixels (for stability scores), in one pass over the logits."""
+        m = self._cell_logits(state, mask_ids, grid_hw).contiguous()
+        b, gh, gw, nm = m.shape[0], m.shape[1], m.shape[2], m.shape[-1]
+        out = torch.empty((b, nm, 4 * gh, 4 * gw), dtype=m.dtype)
+        counts = torch.empty((b, nm, 2), dtype=torch.int64)
+        scatter_logits_counts(
+            m.numpy(), valid_hw[0], valid_hw[1], float(hi), float(lo), out.numpy(), counts.numpy()
+        )
+        return out, counts
 
     def decode(
         self, sparse: torch.Tensor, multimask_output: bool = True
