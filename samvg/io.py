@@ -13,6 +13,15 @@ from PIL import Image
 from samvg.errors import InputError
 
 
+def replace_with_default_permissions(temporary: str | os.PathLike[str], target: Path) -> None:
+    """Rename a finished temporary file onto ``target`` with the usual permissions (0666 less
+    the umask; temporary files are created 0600)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(temporary, 0o666 & ~umask)
+    os.replace(temporary, target)
+
+
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder and a rename.
 
@@ -28,7 +37,7 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
             handle.write(data)
             handle.flush()
             os.fsync(handle.fileno())
-        os.replace(tmp_name, target)
+        replace_with_default_permissions(tmp_name, target)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp_name)

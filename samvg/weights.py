@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from samvg.errors import WeightsError
+from samvg.io import replace_with_default_permissions
 
 __all__ = [
     "WeightSource",
@@ -227,7 +228,7 @@ def download_weights(
                 raise OSError(f"got {size} bytes, expected {spec.size}")
             if spec.sha256 is not None and digest != spec.sha256:
                 raise OSError(f"sha256 mismatch: got {digest}, expected {spec.sha256}")
-            os.replace(tmp, dest)
+            replace_with_default_permissions(tmp, dest)
             tmp_files.remove(tmp)
             return dest
         except (OSError, urllib.error.URLError, ValueError, EOFError) as e:
@@ -308,7 +309,7 @@ def copy_into_cache(spec: WeightSpec, src: str | os.PathLike[str]) -> Path:
     os.close(fd)
     try:
         shutil.copyfile(src, tmp_name)
-        os.replace(tmp_name, dest)
+        replace_with_default_permissions(tmp_name, dest)
     finally:
         Path(tmp_name).unlink(missing_ok=True)
     return dest

@@ -58,3 +58,12 @@ def test_write_png_round_trip_and_missing_folder(tmp_path):
     with pytest.raises(InputError, match="does not exist"):
         write_png(tmp_path / "no" / "a.png", image)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png"]
+
+
+def test_written_files_get_default_permissions(tmp_path):
+    import os
+
+    write_png(tmp_path / "p.png", np.zeros((4, 4, 3)))
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (tmp_path / "p.png").stat().st_mode & 0o777 == 0o666 & ~umask
