@@ -50,7 +50,6 @@ def _vectorize(arguments: argparse.Namespace, console) -> None:  # type: ignore[
     _check_output(arguments.output, (".svg",))
     if arguments.preview is not None:
         _check_output(arguments.preview, (".png",))
-    image = read_image(arguments.input)
     config = VectorizeConfig(
         checkpoint=arguments.checkpoint,
         model=arguments.model,
@@ -58,6 +57,7 @@ def _vectorize(arguments: argparse.Namespace, console) -> None:  # type: ignore[
         max_paths=arguments.max_paths,
         num_segments=arguments.segments,
     )
+    image = read_image(arguments.input)
     progress, report = _progress_reporter(console)
     with progress:
         result = vectorize(image, config, progress=report)

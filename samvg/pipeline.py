@@ -28,6 +28,23 @@ class VectorizeConfig:
     steps: int = 300
     max_side: int = 512
 
+    def __post_init__(self) -> None:
+        minimums = {
+            "points_per_side": 1,
+            "num_segments": 1,
+            "max_paths": 1,
+            "steps": 0,
+            "max_side": 8,
+        }
+        for name, smallest in minimums.items():
+            value = getattr(self, name)
+            if not isinstance(value, int) or value < smallest:
+                raise InputError(
+                    f"{name.replace('_', ' ')} must be an integer >= {smallest}, got {value!r}"
+                )
+        if not 0.0 <= self.min_area_fraction < 1.0:
+            raise InputError(f"min area fraction must be in [0, 1), got {self.min_area_fraction}")
+
 
 def _downscale(image: np.ndarray, max_side: int) -> tuple[np.ndarray, float]:
     from PIL import Image

@@ -101,3 +101,17 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
     flat_fill_mse = float(np.mean((target - target.mean(axis=(0, 1))) ** 2))
     assert mse < 0.02 and mse < flat_fill_mse / 3, (mse, flat_fill_mse)
     assert read_image(preview).shape == target.shape
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        (["--model", "vit_q"], "unknown SAM model 'vit_q'"),
+        (["--steps", "-3"], "steps must be an integer >= 0"),
+        (["--segments", "0"], "num segments must be an integer >= 1"),
+    ],
+)
+def test_bad_settings_are_clear_errors(tmp_path, capsys, option, message):
+    assert main(["vectorize", str(SAMPLE), "-o", str(tmp_path / "o.svg"), *option]) == 1
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o.svg").exists()

@@ -11,7 +11,7 @@ from pathlib import Path
 import torch
 from torch import nn
 
-from samvg.errors import WeightsError
+from samvg.errors import InputError, WeightsError
 from samvg.sam.image_encoder_vit import ImageEncoderViT
 from samvg.sam.mask_decoder import MaskDecoder
 from samvg.sam.model import Sam
@@ -105,7 +105,7 @@ def build_sam(name: str = "mobile_sam", **encoder_overrides) -> Sam:
     elif name in _VIT_CONFIGS:
         enc = ImageEncoderViT(**{**_VIT_CONFIGS[name], **encoder_overrides})
     else:
-        raise ValueError(f"unknown SAM model {name!r}; choose from {', '.join(MODEL_NAMES)}")
+        raise InputError(f"unknown SAM model {name!r}; choose from {', '.join(MODEL_NAMES)}")
     return _assemble(enc).eval()
 
 
@@ -192,7 +192,7 @@ def load_sam(
     later (``load_state_dict``) is always safe.
     """
     if name not in SPECS:
-        raise ValueError(f"unknown SAM model {name!r}; choose from {', '.join(MODEL_NAMES)}")
+        raise InputError(f"unknown SAM model {name!r}; choose from {', '.join(MODEL_NAMES)}")
     path = resolve_weights(SPECS[name], checkpoint, download=download)
     state = read_checkpoint(path)
     model = build_sam(name)
