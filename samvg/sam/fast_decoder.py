@@ -262,10 +262,10 @@ class FastDecoder:
         a1 = torch.softmax(lg.transpose(0, 1), dim=2).reshape(b, ht, n)
         # LayerNorm statistics of x1 = Y1 + A1 U1
         cross = torch.matmul(vt1.transpose(0, 1).reshape(h, b * t, -1), self.e1t)
-        cross = (cross.view(h, b, t, n).transpose(0, 1) * a1.view(b, h, t, n)).sum((1, 2))
+        cross = cross.view(h, b, t, n).transpose(0, 1).mul_(a1.view(b, h, t, n)).sum((1, 2))
         u1 = _factor(vt1, self.m1c)  # (B, HT, C) centred rows of U1
         g = torch.bmm(u1, u1.transpose(1, 2))
-        quad = (torch.bmm(g, a1) * a1).sum(1)
+        quad = torch.bmm(g, a1).mul_(a1).sum(1)
         c = self.y2.shape[1]
         var1 = (self.y1_sq + 2 * cross + quad) / c
         s1 = torch.rsqrt(var1 + self.eps1)
@@ -303,11 +303,11 @@ class FastDecoder:
         d = torch.cat([a1 * s1[:, None, :], a2, torch.ones_like(a2[:, :1])], dim=1)
         vt12 = torch.cat([vt1, vt2], dim=1)  # (B, 2H, T, d)
         cross = torch.matmul(vt12.transpose(0, 1).reshape(2 * h, b * t, -1), self.e2t)
-        cross = cross.view(2 * h, b, t, n).transpose(0, 1) * d[:, : 2 * ht].view(b, 2 * h, t, n)
+        cross = cross.view(2 * h, b, t, n).transpose(0, 1).mul_(d[:, : 2 * ht].view(b, 2 * h, t, n))
         cross = cross.sum((1, 2)) + self.y_cc
         r = torch.cat([_factor(vt12, self.basis), self.cc.expand(b, 1, -1)], dim=1)  # (B, 2HT+1, C)
         g = torch.bmm(r, r.transpose(1, 2))
-        quad = (torch.bmm(g, d) * d).sum(1)
+        quad = torch.bmm(g, d).mul_(d).sum(1)
         var2 = (s1 * s1 * self.yb1c_sq + 2 * s1 * cross + quad) / c
         s2 = torch.rsqrt(var2 + self.eps2)
         # ---- final token -> image attention
