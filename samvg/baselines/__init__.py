@@ -1,0 +1,100 @@
+"""Baseline vectorizers of the paper's evaluation, run by one function with one shape.
+
+- ``diffvg``: random closed blobs fitted with samvg's optimiser (:mod:`.random_init`);
+- ``live``: LIVE-style layer-wise initialization at regions of high error (:mod:`.live`);
+- ``vtracer``: VTracer with settings searched to match a path count (:mod:`.vtracer_baseline`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from samvg.baselines.common import WHITE, StepProgress, as_target, blob
+from samvg.baselines.live import live, schedule
+from samvg.baselines.random_init import random_blobs, random_init
+from samvg.baselines.vtracer_baseline import TracedSvg, render_svg, vtracer_trace
+from samvg.errors import InputError
+from samvg.vector_image import VectorImage
+
+BASELINES = ("diffvg", "live", "vtracer")
+#: samvg optimises in two phases (after tracing, after adding missing components); a baseline
+#: given only ``fit_options["steps"]`` (one phase) gets this many times as many steps.
+SAMVG_PHASES = 2
+
+Vectorized = VectorImage | TracedSvg
+
+
+def run_baseline(
+    name: str,
+    target: np.ndarray,
+    path_count: int,
+    fit_options: Mapping[str, Any] | None = None,
+    seed: int = 0,
+    *,
+    steps: int | None = None,
+    segments: int = 5,
+    background: tuple[float, float, float] = WHITE,
+    progress: StepProgress | None = None,
+) -> Vectorized:
+    """Vectorize ``target`` (uint8 or float RGB) with baseline ``name`` and ``path_count`` paths.
+
+    ``fit_options`` are the keyword arguments samvg gives :func:`samvg.optimize.fit_paths` for
+    one phase (``samvg.pipeline.fit_options(config)``); the optimising baselines run
+    ``steps`` steps in all, by default ``SAMVG_PHASES * fit_options["steps"]``, so they get
+    samvg's iterations and losses. ``vtracer`` ignores the fitting arguments.
+    """
+    if name not in BASELINES:
+        raise InputError(f"unknown baseline {name!r}; choose from {', '.join(BASELINES)}")
+    if name == "vtracer":
+        return vtracer_trace(target, path_count)
+    if steps is None:
+        if not fit_options or "steps" not in fit_options:
+            raise InputError("give steps, or fit_options with samvg's steps per phase")
+        steps = SAMVG_PHASES * int(fit_options["steps"])
+    method = random_init if name == "diffvg" else live
+    return method(
+        target,
+        path_count,
+        steps=steps,
+        segments=segments,
+        seed=seed,
+        background=background,
+        fit_options=fit_options,
+        progress=progress,
+    )
+
+
+def path_count(result: Vectorized) -> int:
+    """Number of paths (a background colour or rectangle of a VectorImage is not counted)."""
+    return result.path_count if isinstance(result, TracedSvg) else len(result.paths)
+
+
+def parameter_count(result: Vectorized) -> int:
+    """All coordinates and colour values: 6K + 4 per path of K cubic segments (34 for K = 5,
+    the paper's count); for VTracer, every number of its path data and transforms plus RGB."""
+    if isinstance(result, TracedSvg):
+        return result.parameter_count
+    return sum(6 * path.num_segments + 4 for path in result.paths)
+
+
+__all__ = [
+    "BASELINES",
+    "SAMVG_PHASES",
+    "WHITE",
+    "TracedSvg",
+    "Vectorized",
+    "as_target",
+    "blob",
+    "live",
+    "parameter_count",
+    "path_count",
+    "random_blobs",
+    "random_init",
+    "render_svg",
+    "run_baseline",
+    "schedule",
+    "vtracer_trace",
+]

@@ -1,0 +1,167 @@
+"""The vtracer baseline: VTracer (PyPI ``vtracer``) with its settings searched per image so that
+its path count comes as close as possible to a target count.
+
+VTracer's paths are compound (holes as extra subpaths) and carry ``translate`` transforms, which
+:class:`samvg.VectorImage` cannot hold, so its SVG is kept as text and rendered with resvg.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from samvg.baselines.common import as_target, check_counts
+from samvg.errors import SamvgError
+from samvg.io import atomic_write_text
+
+#: (color_precision, layer_difference) pairs tried in turn, VTracer's defaults first; for each,
+#: filter_speckle is bisected.
+SETTINGS_GRID = ((6, 16), (8, 16), (4, 16), (6, 48), (8, 48), (4, 48), (3, 32), (2, 64))
+#: filter_speckle range searched (VTracer discards patches smaller than this many pixels wide).
+SPECKLE_RANGE = (1, 128)
+#: Decimal places of path coordinates (samvg writes 2 as well, so SVG sizes compare).
+PATH_PRECISION = 2
+_INSTALL_HINT = "the vtracer baseline needs the bench extra: pip install 'samvg[bench]'"
+
+
+@dataclass
+class TracedSvg:
+    """VTracer's SVG for one image, with the settings that made it and how many were tried."""
+
+    svg: str
+    width: int
+    height: int
+    settings: dict[str, int] = field(default_factory=dict)
+    evaluations: int = 1
+
+    @property
+    def path_count(self) -> int:
+        """Number of ``<path>`` elements (VTracer's first one is the full-canvas background)."""
+        return len(re.findall(r"<path\b", self.svg))
+
+    @property
+    def parameter_count(self) -> int:
+        """All numbers of the path data and transforms, plus three per fill colour (RGB)."""
+        numbers = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+        data = " ".join(re.findall(r'\bd="([^"]*)"', self.svg))
+        transforms = " ".join(re.findall(r'\btransform="([^"]*)"', self.svg))
+        return (
+            len(re.findall(numbers, data))
+            + len(re.findall(numbers, transforms))
+            + 3 * len(re.findall(r'\bfill="#', self.svg))
+        )
+
+    def to_svg(self) -> str:
+        return self.svg
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write the SVG atomically."""
+        atomic_write_text(path, self.svg)
+
+    def render(self) -> np.ndarray:
+        """Rasterize with resvg over white: float32 (H, W, 3) in [0, 1]."""
+        return render_svg(self.svg, self.width, self.height)
+
+
+def render_svg(svg: str, width: int, height: int) -> np.ndarray:
+    """Render SVG text with resvg at ``width`` × ``height`` over white, float32 (H, W, 3)."""
+    from PIL import Image
+
+    try:
+        import resvg_py
+    except ImportError:
+        raise SamvgError(_INSTALL_HINT + " (resvg-py is missing)") from None
+    try:
+        png = resvg_py.svg_to_bytes(
+            svg_string=svg, background="#ffffff", width=width, height=height
+        )
+    except ValueError as error:
+        raise SamvgError(f"resvg cannot render the SVG: {error}") from None
+    with Image.open(io.BytesIO(bytes(png))) as opened:
+        rgb = np.asarray(opened.convert("RGB"), dtype=np.float32) / 255.0
+    return rgb
+
+
+def trace_once(png: bytes, filter_speckle: int, color_precision: int, layer_difference: int) -> str:
+    """One VTracer run (colour, stacked, spline) on PNG bytes; returns the SVG text."""
+    try:
+        import vtracer
+    except ImportError:
+        raise SamvgError(_INSTALL_HINT + " (vtracer is missing)") from None
+    return vtracer.convert_raw_image_to_svg(
+        png,
+        img_format="png",
+        colormode="color",
+        hierarchical="stacked",
+        mode="spline",
+        filter_speckle=int(filter_speckle),
+        color_precision=int(color_precision),
+        layer_difference=int(layer_difference),
+        path_precision=PATH_PRECISION,
+    )
+
+
+def vtracer_trace(target: np.ndarray, path_count: int, max_evaluations: int = 48) -> TracedSvg:
+    """VTracer's SVG of ``target`` with a path count as close to ``path_count`` as found.
+
+    For each (color_precision, layer_difference) of :data:`SETTINGS_GRID`, filter_speckle is
+    bisected on a log scale (path counts fall as it grows); the search stops at an exact match
+    or after ``max_evaluations`` runs, and keeps the closest result (the first one on ties).
+    """
+    from PIL import Image
+
+    check_counts(path_count, 1)
+    image = np.round(as_target(target) * 255.0).astype(np.uint8)
+    height, width = image.shape[:2]
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, format="PNG")
+    png = buffer.getvalue()
+    cache: dict[tuple[int, int, int], str] = {}
+    best: tuple[int, tuple[int, int, int]] | None = None
+
+    def count(speckle: int, precision: int, difference: int) -> int:
+        nonlocal best
+        key = (speckle, precision, difference)
+        if key not in cache:
+            cache[key] = trace_once(png, speckle, precision, difference)
+        found = len(re.findall(r"<path\b", cache[key]))
+        if best is None or abs(found - path_count) < best[0]:
+            best = (abs(found - path_count), key)
+        return found
+
+    low_bound, high_bound = SPECKLE_RANGE
+    for precision, difference in SETTINGS_GRID:
+        if len(cache) >= max_evaluations or (best is not None and best[0] == 0):
+            break
+        low, high = low_bound, high_bound
+        if count(low, precision, difference) <= path_count:
+            continue  # even the finest speckle filter gives too few paths with these settings
+        if count(high, precision, difference) >= path_count:
+            continue
+        while high - low > 1 and len(cache) < max_evaluations:
+            middle = min(high - 1, max(low + 1, round(math.sqrt(low * high))))
+            found = count(middle, precision, difference)
+            if found == path_count:
+                break
+            if found > path_count:
+                low = middle
+            else:
+                high = middle
+    assert best is not None
+    speckle, precision, difference = best[1]
+    return TracedSvg(
+        svg=cache[best[1]],
+        width=width,
+        height=height,
+        settings={
+            "filter_speckle": speckle,
+            "color_precision": precision,
+            "layer_difference": difference,
+        },
+        evaluations=len(cache),
+    )
