@@ -28,3 +28,8 @@ def bench_dir() -> Path:
     if not (folder / "manifest.csv").is_file():
         pytest.skip("../shared/bench not found")
     return folder
+
+
+@pytest.fixture(scope="session")
+def lpips_weights() -> Path:
+    return shared_file("SAMVG_LPIPS_WEIGHTS", "models/lpips_alex.pt")
