@@ -1,125 +1,270 @@
-"""Mask → closed cubic path: outer contour, a fixed number of corners chosen greedily by global
-maximum of a turning score (SAMVG's variant of Sarfraz's corner detection), one least-squares
-cubic per stretch between corners.
+"""Masks → closed cubic paths (SAMVG stage 2): one path per connected component of each mask.
+
+Each component's outer contour (``samvg.trace.contour``; holes filled) is cut at a fixed number
+of corners (``samvg.trace.corners``) and every stretch between two corners becomes one cubic
+Bézier, fitted by least squares with Newton reparameterization and pinned to the corners
+(``samvg.trace.fit``). All stretches of all masks are fitted in one vectorized batch.
+
+Public API:
+
+* ``trace_masks(masks, image, segments_per_path=4, min_area=16) -> VectorImage``: the paths,
+  filled with the mean colour of the image under each component, in paint order.
+* ``trace_masks_with_info(...) -> (VectorImage, list[TracedPath])``: the same image and, for each
+  of its paths (same order), the source mask index, component area and fitting error.
+* ``trace_components(mask, segments=4, min_area=16) -> list[TracedPath]``: geometry only.
+* ``trace_mask(mask, num_segments=5) -> (3K, 2) points``: the largest component only.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
+
 import numpy as np
-from scipy import ndimage
-from skimage import measure
 
 from samvg.errors import InputError
+from samvg.trace.contour import Components, find_components
+from samvg.trace.corners import select_corners
+from samvg.trace.fit import fit_cubics
+from samvg.vector_image import VectorImage, VectorPath
+
+#: Default smallest component kept, in pixels (a 4 × 4 block): smaller specks would cost a whole
+#: path of 3K control points for almost no pixels, and a few-pixel contour cannot carry K cubics.
+DEFAULT_MIN_AREA = 16
+#: Most contour points a stretch contributes to its cubic's fit (evenly spread along it); the
+#: fitting error is measured on the same points.
+MAX_FIT_POINTS = 64
 
 
-def mask_contour(mask: np.ndarray) -> np.ndarray:
-    """Outer contour (N, 2) in pixel coordinates (x, y) of the mask's largest component.
+@dataclass(frozen=True)
+class TracedPath:
+    """One traced component.
 
-    Pixel (row r, column c) covers [c, c+1] × [r, r+1]; the contour is the 0.5 iso-line
-    through pixel centres, closed (first point not repeated), counter-clockwise on screen.
+    ``points`` (3K, 2): the closed path in :class:`~samvg.vector_image.VectorPath` layout, starting
+    at a corner. ``mask_index``: index of the source mask. ``area``: pixel count of the component
+    (holes not counted). ``max_error`` / ``rms_error``: max and RMS distance in pixels between the
+    contour points and the fitted curve (each point to its Newton-refined parameter's point).
     """
-    binary = np.asarray(mask, dtype=bool)
-    if binary.ndim != 2:
-        raise InputError(f"mask must be two-dimensional, got shape {binary.shape}")
-    labels, count = ndimage.label(binary)
-    if count == 0:
-        raise InputError("mask is empty: nothing to trace")
-    sizes = ndimage.sum_labels(binary, labels, index=np.arange(1, count + 1))
-    largest = ndimage.binary_fill_holes(labels == (int(np.argmax(sizes)) + 1))
-    padded = np.pad(largest.astype(np.float64), 1)
-    contours = measure.find_contours(padded, 0.5)
-    contour = max(contours, key=len)
-    if np.allclose(contour[0], contour[-1]):
-        contour = contour[:-1]
-    xy = np.stack([contour[:, 1] - 0.5, contour[:, 0] - 0.5], axis=1)
-    return xy
+
+    points: np.ndarray
+    mask_index: int
+    area: int
+    max_error: float
+    rms_error: float
 
 
-def _turning_score(contour: np.ndarray, reach: int) -> np.ndarray:
-    """Angle the contour turns through at each point, measured over ``reach`` points each way."""
-    forward = np.roll(contour, -reach, axis=0) - contour
-    backward = contour - np.roll(contour, reach, axis=0)
-    cross = backward[:, 0] * forward[:, 1] - backward[:, 1] * forward[:, 0]
-    dot = np.einsum("ij,ij->i", backward, forward)
-    return np.abs(np.arctan2(cross, dot))
+def _check_count(value: object, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InputError(f"{name} must be a positive integer, got {value!r}")
+    return int(value)
 
 
-def select_corners(contour: np.ndarray, count: int) -> np.ndarray:
-    """Indices of ``count`` corners, in contour order: repeatedly the global maximum of the
-    turning score, suppressing its neighbours; arclength-spaced points fill in on smooth shapes.
-    """
+def _check_min_area(value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputError(f"min_area must be a number of pixels, got {value!r}")
+    if not np.isfinite(value) or value < 0:
+        raise InputError(f"min_area must be a finite number >= 0, got {value!r}")
+    return float(value)
+
+
+def _as_bool_mask(mask: object, index: int, shape: tuple[int, ...] | None) -> np.ndarray:
+    """``mask`` as a boolean array, checked: two-dimensional, of ``shape``, values 0/1 only."""
+    array = np.asarray(mask)
+    if array.ndim != 2:
+        raise InputError(f"mask {index} must be two-dimensional (H, W), got shape {array.shape}")
+    if shape is not None and array.shape != shape:
+        raise InputError(
+            f"mask {index} has shape {array.shape}, but the image is {shape[0]}x{shape[1]} "
+            "(masks and image must have the same height and width)"
+        )
+    if array.dtype == bool:
+        return array
+    if array.dtype.kind not in "iuf":
+        raise InputError(f"mask {index} must be boolean, got dtype {array.dtype}")
+    binary = array != 0
+    if not np.all(binary | (array == 0)) or not np.all(array[binary] == 1):
+        bad = array[(array != 0) & (array != 1)].flat[0]
+        raise InputError(
+            f"mask {index} must be boolean (or only 0 and 1), but contains {bad!r}; "
+            "threshold soft masks first, e.g. mask > 0.5"
+        )
+    return binary
+
+
+def _as_mask_list(masks: object, shape: tuple[int, ...] | None) -> list[np.ndarray]:
+    expected = "masks must be a list of (H, W) masks or an (N, H, W) array"
+    if isinstance(masks, np.ndarray):
+        if masks.ndim != 3:
+            hint = "; wrap a single mask in a list" if masks.ndim == 2 else ""
+            raise InputError(f"{expected}, got an array of shape {masks.shape}{hint}")
+        items: Sequence[object] = list(masks)
+    elif isinstance(masks, (list, tuple)):
+        items = masks
+    else:
+        raise InputError(f"{expected}, got {type(masks).__name__}")
+    return [_as_bool_mask(mask, index, shape) for index, mask in enumerate(items)]
+
+
+def _as_rgb(image: object) -> np.ndarray:
+    """The image as float32 (H, W, 3) in [0, 1]."""
+    array = np.asarray(image)
+    if array.ndim != 3 or array.shape[2] != 3 or array.shape[0] < 1 or array.shape[1] < 1:
+        raise InputError(f"image must be RGB with shape (H, W, 3), got shape {array.shape}")
+    if array.dtype == np.uint8:
+        return array.astype(np.float32) / np.float32(255.0)
+    if array.dtype.kind != "f":
+        raise InputError(f"image must be uint8 or float in [0, 1], got dtype {array.dtype}")
+    if not np.all(np.isfinite(array)) or array.min() < 0.0 or array.max() > 1.0:
+        raise InputError("float image values must be finite and in [0, 1]")
+    return array.astype(np.float32)
+
+
+def _densify(contour: np.ndarray, minimum: int) -> np.ndarray:
+    """Insert evenly spaced points on every edge until the contour has ``minimum`` points."""
+    if len(contour) >= minimum:
+        return contour
+    pieces = -(-minimum // len(contour))
+    following = np.roll(contour, -1, axis=0)
+    fractions = np.arange(pieces) / pieces
+    dense = contour[:, None, :] + fractions[None, :, None] * (following - contour)[:, None, :]
+    return dense.reshape(-1, 2)
+
+
+def _stretches(contour: np.ndarray, segments: int) -> tuple[np.ndarray, np.ndarray]:
+    """The contour cut at ``segments`` corners: for each stretch from a corner to the next (both
+    included) the contour indices of at most ``MAX_FIT_POINTS`` points evenly spread along it,
+    concatenated, and the number of points of each stretch."""
     total = len(contour)
-    if total <= count:
-        return np.arange(total)
-    reach = max(1, min(total // (4 * count), 4))
-    score = _turning_score(contour, reach)
-    suppression = max(1, total // (2 * count))
-    available = np.ones(total, dtype=bool)
-    chosen: list[int] = []
-    significant = np.deg2rad(30.0)
-    while len(chosen) < count:
-        candidates = np.where(available & (score >= significant))[0]
-        if len(candidates) == 0:
-            break
-        best = int(candidates[np.argmax(score[candidates])])
-        chosen.append(best)
-        offsets = (np.arange(total) - best) % total
-        available &= np.minimum(offsets, total - offsets) > suppression
-    if len(chosen) < count:
-        chosen = _fill_by_arclength(contour, chosen, count)
-    return np.sort(np.asarray(chosen, dtype=np.int64))
+    corners = select_corners(contour, segments)
+    while len(corners) < segments:  # cannot happen after _densify; keeps K exact regardless
+        corners = np.append(corners, corners[-1])
+    lengths = (np.append(corners[1:], corners[0]) - corners) % total
+    if segments == 1:
+        lengths[:] = total
+    sizes = np.minimum(lengths + 1, MAX_FIT_POINTS)
+    first = np.cumsum(sizes) - sizes
+    step = np.arange(int(sizes.sum())) - np.repeat(first, sizes)
+    scale = np.repeat(lengths / np.maximum(sizes - 1, 1), sizes)
+    indices = np.repeat(corners, sizes) + np.rint(step * scale).astype(np.int64)
+    return indices % total, sizes
 
 
-def _fill_by_arclength(contour: np.ndarray, chosen: list[int], count: int) -> list[int]:
-    """Add points splitting the longest stretches between chosen corners at their middle."""
-    steps = np.linalg.norm(np.roll(contour, -1, axis=0) - contour, axis=1)
-    cumulative = np.concatenate([[0.0], np.cumsum(steps)])
-    perimeter = cumulative[-1]
-    corners = sorted(chosen) if chosen else [0]
-    while len(corners) < count:
-        lengths = [
-            (cumulative[corners[(i + 1) % len(corners)]] - cumulative[c]) % perimeter or perimeter
-            for i, c in enumerate(corners)
-        ]
-        longest = int(np.argmax(lengths))
-        middle = (cumulative[corners[longest]] + lengths[longest] / 2.0) % perimeter
-        index = int(np.searchsorted(cumulative, middle)) % len(contour)
-        if index in corners:
-            break
-        corners = sorted([*corners, index])
-    return corners
+def _trace(
+    masks: list[np.ndarray], segments: int, min_area: float
+) -> tuple[list[TracedPath], list[Components]]:
+    """Trace every kept component of every mask; one batched fit for all stretches."""
+    found = [find_components(mask, min_area) for mask in masks]
+    runs, sizes, owners, areas = [], [], [], []
+    for mask_index, components in enumerate(found):
+        for contour, area in zip(components.contours, components.areas, strict=True):
+            contour = _densify(contour, 4 * segments)
+            indices, stretch_sizes = _stretches(contour, segments)
+            runs.append(contour[indices])
+            sizes.append(stretch_sizes)
+            owners.append(mask_index)
+            areas.append(int(area))
+    if not runs:
+        return [], found
+    offsets = np.concatenate([[0], np.cumsum(np.concatenate(sizes))])
+    fits = fit_cubics(np.concatenate(runs), offsets)
+    controls = fits.controls.reshape(len(runs), segments, 4, 2)
+    bounds = np.concatenate([[0], np.cumsum([len(run) for run in runs])])
+    traced = []
+    for path, (mask_index, area) in enumerate(zip(owners, areas, strict=True)):
+        distances = fits.distances[bounds[path] : bounds[path + 1]]
+        traced.append(
+            TracedPath(
+                points=controls[path, :, :3, :].reshape(3 * segments, 2),
+                mask_index=mask_index,
+                area=area,
+                max_error=float(distances.max()),
+                rms_error=float(np.sqrt(np.mean(distances**2))),
+            )
+        )
+    return traced, found
 
 
-def _fit_cubic(stretch: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Control points of the cubic through the stretch's ends that fits its points best."""
-    start, end = stretch[0], stretch[-1]
-    if len(stretch) <= 2:
-        return start + (end - start) / 3.0, start + 2.0 * (end - start) / 3.0
-    chords = np.linalg.norm(np.diff(stretch, axis=0), axis=1)
-    t = np.concatenate([[0.0], np.cumsum(chords)])
-    t /= t[-1] if t[-1] > 0 else 1.0
-    b0, b1, b2, b3 = (1 - t) ** 3, 3 * t * (1 - t) ** 2, 3 * t**2 * (1 - t), t**3
-    residual = stretch - np.outer(b0, start) - np.outer(b3, end)
-    design = np.stack([b1, b2], axis=1)
-    solution, *_ = np.linalg.lstsq(design, residual, rcond=None)
-    return solution[0], solution[1]
+def _mean_colours(components: Components, rgb: np.ndarray) -> list[np.ndarray]:
+    """Mean colour of ``rgb`` (float32 (H, W, 3)) over each kept component (its pixels only)."""
+    colours = []
+    top, left = components.origin
+    for label, area, (rows, cols) in zip(
+        components.ids, components.areas, components.boxes, strict=True
+    ):
+        inside = (components.labels[rows, cols] == label).astype(np.float32)
+        region = rgb[top + rows.start : top + rows.stop, left + cols.start : left + cols.stop]
+        total = np.tensordot(inside, region, axes=([0, 1], [0, 1]))
+        colours.append(np.clip(total.astype(np.float64) / area, 0.0, 1.0))
+    return colours
+
+
+def trace_components(
+    mask: np.ndarray, segments: int = 4, min_area: float = DEFAULT_MIN_AREA
+) -> list[TracedPath]:
+    """Trace each connected component of a boolean (H, W) mask with at least ``min_area``
+    pixels into a closed path of ``segments`` cubics, holes filled; largest component first.
+    An empty mask gives an empty list. ``mask_index`` of the results is 0."""
+    segments = _check_count(segments, "segments")
+    min_area = _check_min_area(min_area)
+    traced, _ = _trace([_as_bool_mask(mask, 0, None)], segments, min_area)
+    return traced
+
+
+def trace_masks_with_info(
+    masks: Sequence[np.ndarray] | np.ndarray,
+    image: np.ndarray,
+    segments_per_path: int = 4,
+    min_area: float = DEFAULT_MIN_AREA,
+) -> tuple[VectorImage, list[TracedPath]]:
+    """:func:`trace_masks`, plus one :class:`TracedPath` per path of the image, in the same order
+    (source mask index, component area, fitting error)."""
+    segments = _check_count(segments_per_path, "segments_per_path")
+    min_area = _check_min_area(min_area)
+    rgb = _as_rgb(image)
+    height, width = rgb.shape[:2]
+    binary = _as_mask_list(masks, (height, width))
+    traced, found = _trace(binary, segments, min_area)
+    colours = [colour for components in found for colour in _mean_colours(components, rgb)]
+    paths = [
+        VectorPath(path.points, (*colour, 1.0))
+        for path, colour in zip(traced, colours, strict=True)
+    ]
+    return VectorImage(width, height, paths), traced
+
+
+def trace_masks(
+    masks: Sequence[np.ndarray] | np.ndarray,
+    image: np.ndarray,
+    segments_per_path: int = 4,
+    min_area: float = DEFAULT_MIN_AREA,
+) -> VectorImage:
+    """Trace boolean masks (a list of (H, W) arrays or an (N, H, W) array, in paint order) over
+    an RGB ``image`` (H, W, 3; uint8, or float in [0, 1]) into a :class:`VectorImage` without a
+    background.
+
+    Every connected component (4-connected) of every mask with at least ``min_area`` pixels
+    becomes one closed path of ``segments_per_path`` cubic segments with its holes filled (masks
+    painted later cover them), filled opaque with the mean image colour under the component.
+    Paths follow the mask order, the components of one mask largest first; empty masks and
+    masks with only smaller components add nothing. Non-boolean masks (values other than 0/1),
+    masks that are not (H, W) or differ in size from the image raise :class:`InputError`.
+    """
+    return trace_masks_with_info(masks, image, segments_per_path, min_area)[0]
 
 
 def trace_mask(mask: np.ndarray, num_segments: int = 5) -> np.ndarray:
-    """Trace a mask into a closed cubic path of ``num_segments`` segments: (3K, 2) points."""
-    if num_segments < 1:
-        raise InputError(f"num_segments must be at least 1, got {num_segments}")
-    contour = mask_contour(mask)
-    corners = select_corners(contour, num_segments)
-    while len(corners) < num_segments:  # tiny contours: repeat a corner (zero-length segment)
-        corners = np.sort(np.append(corners, corners[-1]))
-    points = []
-    for i, first in enumerate(corners):
-        last = corners[(i + 1) % len(corners)]
-        if last > first:
-            stretch = contour[first : last + 1]
-        else:
-            stretch = np.concatenate([contour[first:], contour[: last + 1]])
-        c1, c2 = _fit_cubic(stretch)
-        points.extend([contour[first], c1, c2])
-    return np.asarray(points, dtype=np.float64)
+    """Trace the largest component of a mask (holes filled) into ``num_segments`` cubics:
+    (3K, 2) points in :class:`~samvg.vector_image.VectorPath` layout. Any non-zero value counts
+    as inside; an empty mask raises :class:`InputError`."""
+    num_segments = _check_count(num_segments, "num_segments")
+    binary = np.asarray(mask)
+    if binary.ndim != 2:
+        raise InputError(f"mask must be two-dimensional, got shape {binary.shape}")
+    components = find_components(binary.astype(bool, copy=False))
+    if not components.contours:
+        raise InputError("mask is empty: nothing to trace")
+    largest = components.contours[0]
+    contour = _densify(largest, 4 * num_segments)
+    indices, sizes = _stretches(contour, num_segments)
+    fits = fit_cubics(contour[indices], np.concatenate([[0], np.cumsum(sizes)]))
+    return fits.controls[:, :3, :].reshape(3 * num_segments, 2)

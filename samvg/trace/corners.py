@@ -1,0 +1,94 @@
+"""Corner selection on a closed contour: exactly ``count`` points where the path's segments meet.
+
+SAMVG's variant of Sarfraz & Khan (2004): every contour point gets a sharpness score (the angle
+the lightly smoothed contour turns through over a few points each way); the global maximum is the
+first corner, candidates near it are suppressed, the next maximum is taken, and so on until
+``count`` corners are chosen. Only local maxima turning by at least ``min_turn`` degrees count as
+corners; when a shape has fewer (a disk, an ellipse), the remaining ones split the longest
+stretch between chosen corners at its arclength middle, so smooth shapes get evenly spread
+segments and every path has the same number of segments.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Smallest turning angle (degrees, over ``reach`` points each way) of a real corner.
+MIN_TURN_DEGREES = 30.0
+
+
+def _circular(values: np.ndarray, before: int, after: int) -> np.ndarray:
+    """``values`` extended cyclically by ``before`` items in front and ``after`` behind."""
+    return np.concatenate([values[len(values) - before :], values, values[:after]])
+
+
+def smooth_contour(contour: np.ndarray) -> np.ndarray:
+    """The closed contour filtered with the binomial kernel [1, 4, 6, 4, 1] / 16."""
+    n = len(contour)
+    ext = _circular(np.asarray(contour, dtype=np.float64), 2, 2)
+    return (ext[:n] + ext[4 : n + 4] + 4.0 * (ext[1 : n + 1] + ext[3 : n + 3]) + 6.0 * contour) / 16
+
+
+def turning_score(contour: np.ndarray, reach: int) -> np.ndarray:
+    """Angle (radians, in [0, π]) the contour turns through at each point, measured between the
+    chords to the points ``reach`` steps behind and ahead."""
+    n = len(contour)
+    ext = _circular(contour, reach, reach)
+    forward = ext[2 * reach : 2 * reach + n] - contour
+    backward = contour - ext[:n]
+    cross = backward[:, 0] * forward[:, 1] - backward[:, 1] * forward[:, 0]
+    dot = np.einsum("ij,ij->i", backward, forward)
+    return np.abs(np.arctan2(cross, dot))
+
+
+def select_corners(
+    contour: np.ndarray, count: int, min_turn: float = MIN_TURN_DEGREES
+) -> np.ndarray:
+    """Indices of ``count`` corners of a closed (N, 2) contour, increasing.
+
+    Returns all N indices when N <= ``count`` (the caller densifies short contours first).
+    """
+    total = len(contour)
+    if total <= count:
+        return np.arange(total)
+    reach = max(1, min(total // (4 * count), 4))
+    score = turning_score(smooth_contour(contour), reach)
+    # Local maxima over ±reach (plateaus keep their first point).
+    peak = np.ones(total, dtype=bool)
+    ext = _circular(score, reach, reach)
+    for shift in range(1, reach + 1):
+        peak &= score >= ext[reach - shift : reach - shift + total]
+        peak &= score > ext[reach + shift : reach + shift + total]
+    candidates = np.flatnonzero(peak & (score >= np.deg2rad(min_turn)))
+    candidates = candidates[np.argsort(-score[candidates], kind="stable")]
+    suppression = max(reach, total // (4 * count))
+    chosen: list[int] = []
+    for candidate in candidates:
+        if chosen:
+            offsets = np.abs(np.asarray(chosen) - candidate)
+            if np.min(np.minimum(offsets, total - offsets)) <= suppression:
+                continue
+        chosen.append(int(candidate))
+        if len(chosen) == count:
+            break
+    return fill_by_arclength(contour, chosen, count)
+
+
+def fill_by_arclength(contour: np.ndarray, chosen: list[int], count: int) -> np.ndarray:
+    """``chosen`` plus points splitting the longest stretches at their middle, up to ``count``."""
+    steps = np.linalg.norm(np.diff(_circular(contour, 0, 1), axis=0), axis=1)
+    cumulative = np.concatenate([[0.0], np.cumsum(steps)])
+    perimeter = cumulative[-1]
+    total = len(contour)
+    corners = np.sort(np.asarray(chosen if chosen else [0], dtype=np.int64))
+    while len(corners) < count:
+        following = np.roll(corners, -1)
+        lengths = (cumulative[following] - cumulative[corners]) % perimeter
+        lengths[following == corners] = perimeter
+        longest = int(np.argmax(lengths))
+        middle = (cumulative[corners[longest]] + lengths[longest] / 2.0) % perimeter
+        index = int(np.searchsorted(cumulative, middle)) % total
+        if index in corners:  # stretch of a single step: cannot split at a contour point
+            break
+        corners = np.sort(np.append(corners, index))
+    return corners

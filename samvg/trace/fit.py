@@ -1,0 +1,119 @@
+"""Least-squares cubic Bézier fits of many point runs at once, endpoints pinned.
+
+Schneider's method ("An algorithm for automatically fitting digitized curves", Graphics Gems,
+1990) without the recursive splitting: chord-length parameters, a linear least-squares solve for
+the two inner control points, then a few rounds of Newton reparameterization
+``t ← t − f·f′ / (f′·f′ + f·f″)`` (``f = B(t) − p``), each followed by a new solve. All runs are
+processed together with NumPy (``np.bincount`` sums the normal equations per run), so the cost
+is a few dozen array operations over the concatenated points whatever the number of runs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Newton reparameterization rounds after the chord-length fit.
+NEWTON_ITERATIONS = 3
+# Ridge weight pulling the inner control points towards the chord's thirds: makes runs of two or
+# three points (no or one interior point) well posed and is negligible otherwise.
+_RIDGE = 1e-6
+
+
+@dataclass(frozen=True)
+class CubicFits:
+    """``controls`` (S, 4, 2): one cubic per run; ``distances`` (M,): distance of each input point
+    to its parameter's point on its run's cubic (after a last Newton step, so close to the
+    distance to the curve), zero at the pinned endpoints."""
+
+    controls: np.ndarray
+    distances: np.ndarray
+
+
+def fit_cubics(
+    points: np.ndarray, offsets: np.ndarray, iterations: int = NEWTON_ITERATIONS
+) -> CubicFits:
+    """Fit one cubic to each run ``points[offsets[j] : offsets[j + 1]]`` (two points or more),
+    pinned to the run's first and last points."""
+    points = np.asarray(points, dtype=np.float64)
+    offsets = np.asarray(offsets, dtype=np.int64)
+    runs = len(offsets) - 1
+    if runs <= 0:
+        return CubicFits(np.zeros((0, 4, 2)), np.zeros(0))
+    lengths = np.diff(offsets)
+    if np.any(lengths < 2):
+        raise ValueError("every run needs at least two points")
+    run_of = np.repeat(np.arange(runs), lengths)
+    heads, tails = offsets[:-1], offsets[1:] - 1
+    px, py = points[:, 0].copy(), points[:, 1].copy()
+    sx, sy, ex, ey = px[heads], py[heads], px[tails], py[tails]
+    # Each run's start and end, per point (the pinned terms of the Bézier).
+    psx, psy, pex, pey = sx[run_of], sy[run_of], ex[run_of], ey[run_of]
+
+    # Chord-length parameters, 0 at each run's first point and 1 at its last.
+    steps = np.empty(len(px))
+    steps[0] = 0.0
+    steps[1:] = np.hypot(np.diff(px), np.diff(py))
+    steps[heads] = 0.0
+    cumulative = np.cumsum(steps)
+    cumulative -= cumulative[heads][run_of]
+    span = cumulative[tails]
+    t = cumulative / np.where(span > 0, span, 1.0)[run_of]
+    t[tails] = 1.0
+    free = np.ones(len(px), dtype=bool)
+    free[heads] = free[tails] = False
+
+    def per_run(weights: np.ndarray) -> np.ndarray:
+        return np.bincount(run_of, weights=weights, minlength=runs)
+
+    def solve(t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Inner control points (c1x, c1y, c2x, c2y) per run minimizing the squared error."""
+        s = 1.0 - t
+        b0, b1, b2, b3 = s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t
+        rx = px - b0 * psx - b3 * pex
+        ry = py - b0 * psy - b3 * pey
+        a11 = per_run(b1 * b1) + _RIDGE
+        a12 = per_run(b1 * b2)
+        a22 = per_run(b2 * b2) + _RIDGE
+        r1x = per_run(b1 * rx) + _RIDGE * (sx + (ex - sx) / 3.0)
+        r1y = per_run(b1 * ry) + _RIDGE * (sy + (ey - sy) / 3.0)
+        r2x = per_run(b2 * rx) + _RIDGE * (sx + 2.0 * (ex - sx) / 3.0)
+        r2y = per_run(b2 * ry) + _RIDGE * (sy + 2.0 * (ey - sy) / 3.0)
+        det = a11 * a22 - a12 * a12
+        return (
+            (a22 * r1x - a12 * r2x) / det,
+            (a22 * r1y - a12 * r2y) / det,
+            (a11 * r2x - a12 * r1x) / det,
+            (a11 * r2y - a12 * r1y) / det,
+        )
+
+    def newton(t: np.ndarray, controls: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """Newton-updated parameters, and |B(t) − p| at the parameters given."""
+        c1x, c1y, c2x, c2y = (c[run_of] for c in controls)
+        s = 1.0 - t
+        b0, b1, b2, b3 = s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t
+        fx = b0 * psx + b1 * c1x + b2 * c2x + b3 * pex - px
+        fy = b0 * psy + b1 * c1y + b2 * c2y + b3 * pey - py
+        # Derivatives: B' = 3 Σ Bernstein(2) × control differences, B'' = 6 Σ Bernstein(1) × ...
+        q0, q1, q2 = 3.0 * s * s, 6.0 * s * t, 3.0 * t * t
+        d1x = q0 * (c1x - psx) + q1 * (c2x - c1x) + q2 * (pex - c2x)
+        d1y = q0 * (c1y - psy) + q1 * (c2y - c1y) + q2 * (pey - c2y)
+        d2x = 6.0 * (s * (c2x - 2.0 * c1x + psx) + t * (pex - 2.0 * c2x + c1x))
+        d2y = 6.0 * (s * (c2y - 2.0 * c1y + psy) + t * (pey - 2.0 * c2y + c1y))
+        numerator = fx * d1x + fy * d1y
+        denominator = d1x * d1x + d1y * d1y + fx * d2x + fy * d2y
+        safe = free & (np.abs(denominator) > 1e-12)
+        updated = t.copy()
+        updated[safe] -= numerator[safe] / denominator[safe]
+        return np.clip(updated, 0.0, 1.0), np.hypot(fx, fy)
+
+    controls = solve(t)
+    for _ in range(iterations):
+        t, _ = newton(t, controls)
+        controls = solve(t)
+    t, _ = newton(t, controls)
+    _, distances = newton(t, controls)
+    c1x, c1y, c2x, c2y = controls
+    stacked = np.stack([sx, sy, c1x, c1y, c2x, c2y, ex, ey], axis=1).reshape(runs, 4, 2)
+    return CubicFits(stacked, distances)
