@@ -1,0 +1,171 @@
+"""The ``samvg-bench`` command line: run the paper's evaluation on a manifest of images."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from samvg.errors import SamvgError
+
+
+def _names(text: str) -> list[str]:
+    return [name.strip() for name in text.split(",") if name.strip()]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from samvg.bench.methods import DEFAULT_METHODS, METHODS
+
+    parser = argparse.ArgumentParser(
+        prog="samvg-bench",
+        description=(
+            "Vectorize every image of a manifest with each method, score the results and write "
+            "results.csv, summary.md, plots and a contact sheet into --out. Finished results "
+            "are kept: rerunning the same command resumes."
+        ),
+        epilog="methods: "
+        + "; ".join(f"{name}: {method.description}" for name, method in METHODS.items()),
+    )
+    parser.add_argument("--manifest", type=Path, help="CSV with id, category, png columns")
+    parser.add_argument("--out", type=Path, required=True, help="output folder")
+    parser.add_argument(
+        "--methods",
+        type=_names,
+        default=list(DEFAULT_METHODS),
+        help=f"comma-separated (default {','.join(DEFAULT_METHODS)})",
+    )
+    parser.add_argument("--limit", type=int, help="only the first N images")
+    parser.add_argument("--categories", type=_names, help="comma-separated categories only")
+    parser.add_argument("--size", type=int, default=512, help="working size, longest side")
+    parser.add_argument("--iterations", type=int, help="optimization steps per phase")
+    parser.add_argument("--seed", type=int, help="random seed (samvg and the baselines)")
+    parser.add_argument(
+        "--fast", action="store_true", help="start from samvg's fast preset (Config.fast())"
+    )
+    parser.add_argument("--checkpoint", help="SAM checkpoint file")
+    parser.add_argument("--lpips-weights", help="LPIPS weights file (else the usual lookup)")
+    parser.add_argument("--fid-weights", help="FID Inception weights (else the usual lookup)")
+    parser.add_argument(
+        "--retry-failed", action="store_true", help="run again what failed in an earlier run"
+    )
+    parser.add_argument(
+        "--report-only", action="store_true", help="only rewrite the report from --out"
+    )
+    return parser
+
+
+class _RichProgress:
+    """Two bars: image × method results, and the steps of the method now running."""
+
+    def __init__(self, console: Any) -> None:
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+        )
+
+        self.console = console
+        self.progress = Progress(
+            TextColumn("{task.description}", markup=False),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=console,
+        )
+        self.overall = self.progress.add_task("results", total=None)
+        self.current = self.progress.add_task("", total=None, visible=False)
+        self.label = ""
+
+    def start(self, total: int) -> None:
+        self.progress.update(self.overall, total=total)
+
+    def begin(self, image_id: str, method: str) -> None:
+        self.label = f"{image_id} · {method}"
+        self.progress.reset(self.current, total=None, description=self.label, visible=True)
+
+    def stage(self, stage: str, done: int, total: int) -> None:
+        self.progress.update(
+            self.current, description=f"{self.label} · {stage}", completed=done, total=total
+        )
+
+    def end(self, record: dict[str, Any]) -> None:
+        self.progress.advance(self.overall)
+        if record.get("status") != "ok":
+            error = str(record.get("error", "")).splitlines()[0]
+            self.console.print(
+                f"failed: {record['id']} · {record['method']}: {error}",
+                markup=False,
+                highlight=False,
+                soft_wrap=True,
+            )
+
+
+def _run(arguments: argparse.Namespace, console: Any, command: str) -> None:
+    from samvg import Config
+    from samvg.bench.report import write_report
+    from samvg.bench.runner import run_bench
+
+    if arguments.report_only:
+        summary = write_report(arguments.out, fid_weights=arguments.fid_weights)
+        console.print(f"wrote {summary}", markup=False, highlight=False, soft_wrap=True)
+        return
+    if arguments.manifest is None:
+        raise SamvgError("--manifest is required (except with --report-only)")
+    config = Config.fast() if arguments.fast else Config()
+    if arguments.checkpoint:
+        config = config.replace(checkpoint=arguments.checkpoint)
+    if arguments.lpips_weights:
+        config = config.replace(lpips_weights=arguments.lpips_weights)
+    reporter = _RichProgress(console)
+    with reporter.progress:
+        outcome = run_bench(
+            arguments.manifest,
+            arguments.out,
+            arguments.methods,
+            size=arguments.size,
+            iterations=arguments.iterations,
+            seed=arguments.seed,
+            limit=arguments.limit,
+            categories=arguments.categories,
+            retry_failed=arguments.retry_failed,
+            config=config,
+            lpips_weights=arguments.lpips_weights,
+            fid_weights=arguments.fid_weights,
+            progress=reporter,
+            command=command,
+        )
+    console.print(
+        f"{outcome.done} results made, {outcome.skipped} already there, {outcome.failed} failed; "
+        f"see {outcome.out / 'summary.md'}",
+        markup=False,
+        highlight=False,
+        soft_wrap=True,
+    )
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status (0 ok, 1 error, 130 interrupted)."""
+    from rich.console import Console
+    from rich.markup import escape
+
+    words = list(sys.argv[1:] if argv is None else argv)
+    arguments = build_parser().parse_args(words)
+    console = Console(stderr=True)
+    try:
+        _run(arguments, console, shlex.join(["samvg-bench", *words]))
+    except SamvgError as error:
+        console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, soft_wrap=True)
+        return 1
+    except KeyboardInterrupt:
+        console.print("interrupted")
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

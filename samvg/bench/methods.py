@@ -1,0 +1,131 @@
+"""The benchmark's method table: each method vectorizes one target image under a shared config.
+
+``samvg`` and ``samvg-nofilter`` (Table 2's ablation) run the product; ``diffvg``, ``live`` and
+``vtracer`` are the baselines of :mod:`samvg.baselines`, given samvg's path count on the same
+image, samvg's losses and its iteration budget (both phases).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from samvg.baselines import SAMVG_PHASES, TracedSvg, Vectorized, run_baseline
+from samvg.errors import WeightsError
+
+if TYPE_CHECKING:
+    from samvg import Config
+
+
+@dataclass
+class MethodRun:
+    """What a method gets for one image: the target (float32 (H, W, 3) in [0, 1]) at the
+    working size, the config, samvg's path count on this image (for the baselines), the
+    image's id and a progress callback ``progress(stage, done, total)``."""
+
+    target: np.ndarray
+    config: Config
+    path_count: int | None = None
+    image_id: str = ""
+    progress: Callable[[str, int, int], None] = lambda _stage, _done, _total: None
+    details: dict[str, Any] = field(default_factory=dict)
+    """Filled by the method: anything worth keeping in the image's record."""
+
+
+@dataclass(frozen=True)
+class Method:
+    """A named way to vectorize; ``needs_path_count`` methods run after samvg on each image."""
+
+    name: str
+    run: Callable[[MethodRun], Vectorized]
+    needs_path_count: bool = False
+    description: str = ""
+
+
+def _samvg(config_change: dict[str, Any]) -> Callable[[MethodRun], Vectorized]:
+    def vectorize_with_samvg(job: MethodRun) -> Vectorized:
+        from samvg.pipeline import run
+
+        config = job.config.replace(**config_change) if config_change else job.config
+        uint8 = np.round(job.target * 255.0).astype(np.uint8)
+        result = run(uint8, config, progress=job.progress)
+        job.details.update(counts=dict(result.counts), notes=list(result.notes))
+        job.details["timings"] = {k: round(v, 3) for k, v in result.timings.items()}
+        return result.image
+
+    return vectorize_with_samvg
+
+
+def baseline_fit_options(job: MethodRun) -> dict[str, Any]:
+    """samvg's fit options for ``job``'s target; without LPIPS weights, samvg's own fallback
+    (MSE + Xing), noted in the record."""
+    from samvg.pipeline import fit_options
+
+    try:
+        return fit_options(job.config, job.target)
+    except (WeightsError, ImportError) as error:
+        job.details.setdefault("notes", []).append(
+            f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}"
+        )
+        return fit_options(job.config)
+
+
+def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:
+    def vectorize_with_baseline(job: MethodRun) -> Vectorized:
+        if job.path_count is None:
+            raise ValueError(f"{name} needs samvg's path count on this image")
+        if name == "vtracer":
+            result = run_baseline(name, job.target, max(1, job.path_count))
+            assert isinstance(result, TracedSvg)
+            job.details.update(settings=result.settings, evaluations=result.evaluations)
+            return result
+        phases = SAMVG_PHASES if job.config.missing_components else 1
+        steps = phases * job.config.iterations
+        job.details["steps"] = steps
+        return run_baseline(
+            name,
+            job.target,
+            max(1, job.path_count),
+            baseline_fit_options(job),
+            seed=job.config.seed,
+            steps=steps,
+            segments=job.config.segments,
+            progress=lambda done, total: job.progress(name, done, total),
+        )
+
+    return vectorize_with_baseline
+
+
+METHODS: dict[str, Method] = {
+    method.name: method
+    for method in (
+        Method("samvg", _samvg({}), description="samvg with the given config"),
+        Method(
+            "samvg-nofilter",
+            _samvg({"filter_by_impact": False}),
+            description="samvg without filter by impact in all stages (the paper's Table 2)",
+        ),
+        Method(
+            "diffvg",
+            _baseline("diffvg"),
+            needs_path_count=True,
+            description="random blobs, fitted like samvg (the paper's DiffVG)",
+        ),
+        Method(
+            "live",
+            _baseline("live"),
+            needs_path_count=True,
+            description="LIVE-style layer-wise initialization, fitted like samvg",
+        ),
+        Method(
+            "vtracer",
+            _baseline("vtracer"),
+            needs_path_count=True,
+            description="VTracer with settings searched to samvg's path count",
+        ),
+    )
+}
+DEFAULT_METHODS = ("samvg", "samvg-nofilter", "diffvg", "live", "vtracer")

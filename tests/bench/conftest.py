@@ -1,0 +1,46 @@
+"""Fixtures of the benchmark tests: a tiny manifest of real images and the metric weights."""
+
+import csv
+import os
+from pathlib import Path
+
+import pytest
+
+SHARED = Path(__file__).resolve().parents[2].parent / "shared"
+
+
+def _shared_file(variable: str, relative: str) -> Path:
+    candidate = Path(os.environ.get(variable) or SHARED / relative)
+    if not candidate.is_file():
+        pytest.skip(f"{relative} not found (set {variable} or place ../shared beside the repo)")
+    return candidate
+
+
+@pytest.fixture(scope="session")
+def lpips_file() -> Path:
+    return _shared_file("SAMVG_LPIPS_WEIGHTS", "models/lpips_alex.pt")
+
+
+@pytest.fixture(scope="session")
+def fid_file() -> Path:
+    return _shared_file("SAMVG_FID_WEIGHTS", "models/fid_inception_v3.torchscript.pt")
+
+
+@pytest.fixture
+def tiny_manifest(tmp_path: Path, bench_dir: Path) -> Path:
+    """Two real images from two categories and one whose PNG is not an image."""
+    folder = tmp_path / "set"
+    folder.mkdir()
+    (folder / "broken.png").write_bytes(b"not a png")
+    rows = [
+        ("cactus", "emoji", str(bench_dir / "emoji" / "noto_cactus.png")),
+        ("folder", "icon", str(bench_dir / "icon" / "tango_folder_open.png")),
+        ("broken", "icon", "broken.png"),
+    ]
+    manifest = folder / "manifest.csv"
+    with manifest.open("w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["id", "category", "png", "svg", "width", "height"])
+        for image_id, category, png in rows:
+            writer.writerow([image_id, category, png, "", 512, 512])
+    return manifest

@@ -1,0 +1,263 @@
+"""Tests of samvg-bench: manifest reading, the runner (outputs, resuming, failures) and the CLI."""
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from samvg import Config, InputError
+from samvg.baselines import random_init
+from samvg.bench import METHODS, Method, MethodRun, read_manifest, run_bench, write_report
+from samvg.bench.cli import main
+from samvg.bench.runner import plan_methods
+
+TINY = {"size": 64, "iterations": 3}
+
+
+def stand_in_samvg(job: MethodRun):
+    """A quick stand-in for samvg in the runner tests: four fitted random blobs."""
+    job.progress("optimize", 1, 1)
+    return random_init(job.target, 4, steps=2, seed=job.config.seed)
+
+
+def failing_on_folder(job: MethodRun):
+    if job.image_id == "folder":
+        raise RuntimeError("boom")
+    return random_init(job.target, 2, steps=1)
+
+
+TABLE = {
+    **METHODS,
+    "samvg": Method("samvg", stand_in_samvg),
+    "flaky": Method("flaky", failing_on_folder),
+}
+
+
+def read_rows(out: Path) -> list[dict]:
+    with (out / "results.csv").open(newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_manifest_of_the_bench_set(bench_dir):
+    images = read_manifest(bench_dir / "manifest.csv")
+    assert len(images) >= 70 and len({i.id for i in images}) == len(images)
+    assert all(image.png.is_file() for image in images)
+    emoji = read_manifest(bench_dir / "manifest.csv", ["emoji"], limit=3)
+    assert [i.category for i in emoji] == ["emoji"] * 3
+    with pytest.raises(InputError, match="unknown category emojis; the manifest has clipart"):
+        read_manifest(bench_dir / "manifest.csv", ["emojis"])
+
+
+def test_manifest_mistakes_are_plain_errors(tmp_path):
+    with pytest.raises(InputError, match="manifest not found"):
+        read_manifest(tmp_path / "none.csv")
+    bad = tmp_path / "m.csv"
+    bad.write_text("id,png\na,a.png\n")
+    with pytest.raises(InputError, match="category"):
+        read_manifest(bad)
+    bad.write_text("id,category,png\na,x,a.png\na,x,b.png\n")
+    with pytest.raises(InputError, match="duplicate id 'a'"):
+        read_manifest(bad)
+    bad.write_text("id,category,png\n../up,x,a.png\n")
+    with pytest.raises(InputError, match="id '../up'"):
+        read_manifest(bad)
+
+
+def test_methods_are_planned_with_samvg_first():
+    names = [m.name for m in plan_methods(["live", "vtracer"])]
+    assert names == ["samvg", "live", "vtracer"]
+    assert [m.name for m in plan_methods(["diffvg", "samvg-nofilter", "samvg"])] == [
+        "samvg",
+        "diffvg",
+        "samvg-nofilter",
+    ]
+    with pytest.raises(InputError, match="unknown method"):
+        plan_methods(["samvg", "potrace"])
+
+
+def test_run_writes_results_resumes_and_records_failures(tiny_manifest, tmp_path, lpips_file):
+    out = tmp_path / "out"
+    methods = ["samvg", "diffvg", "live", "vtracer", "flaky"]
+    config = Config(use_lpips=False)
+    first = run_bench(
+        tiny_manifest,
+        out,
+        methods,
+        config=config,
+        method_table=TABLE,
+        lpips_weights=lpips_file,
+        report=False,
+        **TINY,
+    )
+    assert (first.done, first.failed, first.skipped) == (9, 6, 0)
+    rows = read_rows(out)
+    assert len(rows) == 15
+    by_key = {(r["id"], r["method"]): r for r in rows}
+    # the unreadable image fails for every method, with its reason
+    assert all(by_key["broken", m]["status"] == "error" for m in methods)
+    assert "cannot read image" in by_key["broken", "samvg"]["error"]
+    # a method raising on one image is recorded; the run went on
+    assert by_key["folder", "flaky"]["status"] == "error"
+    assert "RuntimeError: boom" in by_key["folder", "flaky"]["error"]
+    assert by_key["cactus", "flaky"]["status"] == "ok"
+    for image in ("cactus", "folder"):
+        assert by_key[image, "samvg"]["paths"] == "4"
+        assert by_key[image, "diffvg"]["paths"] == "4" and by_key[image, "live"]["paths"] == "4"
+        assert abs(int(by_key[image, "vtracer"]["paths"]) - 4) <= 2
+        assert by_key[image, "diffvg"]["parameters"] == str(4 * 34)
+        for method in ("samvg", "diffvg", "live", "vtracer"):
+            row = by_key[image, method]
+            assert row["status"] == "ok", row
+            assert 0 < float(row["mse"]) < 0.2 and 0 <= float(row["lpips"]) < 1
+            assert float(row["psnr"]) > 5 and -1 <= float(row["ssim"]) <= 1
+            assert float(row["complexity"]) > 0 and float(row["time_s"]) >= 0
+            svg = out / "svg" / method / f"{image}.svg"
+            assert int(row["svg_bytes"]) == len(svg.read_bytes())
+            assert (out / "renders" / method / f"{image}.png").is_file()
+    assert json.loads(by_key["cactus", "diffvg"]["details"])["steps"] == 2 * 3
+
+    # rerun: nothing is redone (failures are kept too), files untouched
+    stamp = (out / "records" / "live" / "cactus.json").stat().st_mtime_ns
+    again = run_bench(
+        tiny_manifest,
+        out,
+        methods,
+        config=config,
+        method_table=TABLE,
+        lpips_weights=lpips_file,
+        report=False,
+        **TINY,
+    )
+    assert (again.done, again.failed, again.skipped) == (0, 0, 15)
+    assert (out / "records" / "live" / "cactus.json").stat().st_mtime_ns == stamp
+    retry = run_bench(
+        tiny_manifest,
+        out,
+        methods,
+        config=config,
+        method_table=TABLE,
+        lpips_weights=lpips_file,
+        report=False,
+        retry_failed=True,
+        **TINY,
+    )
+    assert (retry.done, retry.failed, retry.skipped) == (0, 6, 9)
+
+    with pytest.raises(InputError, match="other settings.*iterations: 3 -> 4"):
+        run_bench(
+            tiny_manifest,
+            out,
+            methods,
+            config=config,
+            method_table=TABLE,
+            lpips_weights=lpips_file,
+            size=64,
+            iterations=4,
+        )
+
+
+def test_report_in_the_papers_layout(tiny_manifest, tmp_path, lpips_file, fid_file):
+    out = tmp_path / "out"
+    run_bench(
+        tiny_manifest,
+        out,
+        ["samvg", "diffvg", "vtracer"],
+        config=Config(use_lpips=False),
+        method_table=TABLE,
+        lpips_weights=lpips_file,
+        fid_weights=fid_file,
+        command="samvg-bench --test",
+        **TINY,
+    )
+    summary = (out / "summary.md").read_text()
+    assert "| Metrics | samvg | diffvg | vtracer |" in summary
+    for label in (
+        "MSE ×10⁻³",
+        "LPIPS",
+        "FID",
+        "Complexity",
+        "Paths",
+        "Num of parameters",
+        "Time (s)",
+        "SVG bytes",
+        "PSNR",
+        "SSIM",
+    ):
+        assert f"| {label}" in summary
+    assert "### emoji" in summary and "### icon" in summary
+    assert "samvg-bench --test" in summary
+    assert "| broken | samvg | InputError: cannot read image" in summary
+    assert "2 of 3 images have results from every method" in summary
+    fid_line = next(line for line in summary.splitlines() if line.startswith("| FID"))
+    assert "n/a" not in fid_line
+    for name in ("time_vs_paths.png", "mse_vs_paths.png", "contact_sheet.png"):
+        assert (out / name).stat().st_size > 1000
+    # the report can be rewritten from the folder alone, by the CLI too
+    assert main(["--out", str(out), "--report-only", "--fid-weights", str(fid_file)]) == 0
+    assert write_report(out, fid_weights=fid_file) == out / "summary.md"
+
+
+def test_cli_runs_and_resumes(tiny_manifest, tmp_path, lpips_file, fid_file, monkeypatch, capsys):
+    monkeypatch.setitem(METHODS, "samvg", Method("samvg", stand_in_samvg))
+    out = tmp_path / "cli"
+    arguments = [
+        "--manifest",
+        str(tiny_manifest),
+        "--out",
+        str(out),
+        "--methods",
+        "vtracer",
+        "--size",
+        "64",
+        "--iterations",
+        "2",
+        "--limit",
+        "2",
+        "--categories",
+        "emoji,icon",
+        "--lpips-weights",
+        str(lpips_file),
+        "--fid-weights",
+        str(fid_file),
+    ]
+    assert main(arguments) == 0
+    assert "4 results made, 0 already there, 0 failed" in capsys.readouterr().err
+    assert {(r["id"], r["method"]) for r in read_rows(out)} == {
+        (i, m) for i in ("cactus", "folder") for m in ("samvg", "vtracer")
+    }
+    assert "--methods vtracer" in (out / "summary.md").read_text()
+    assert main(arguments) == 0
+    assert "0 results made, 4 already there" in capsys.readouterr().err
+
+
+def test_cli_reports_mistakes_plainly(tmp_path, capsys):
+    assert main(["--out", str(tmp_path / "o"), "--manifest", str(tmp_path / "no.csv")]) == 1
+    assert "manifest not found" in capsys.readouterr().err
+    assert main(["--out", str(tmp_path / "o")]) == 1
+    assert "--manifest is required" in capsys.readouterr().err
+    assert main(["--out", str(tmp_path / "empty"), "--report-only"]) == 1
+
+
+@pytest.mark.slow
+def test_real_methods_on_a_tiny_image(tiny_manifest, tmp_path, lpips_file, sam_checkpoint):
+    """The real samvg pipeline and its ablation, then the baselines at its path count."""
+    out = tmp_path / "out"
+    config = Config(points_per_side=4, use_lpips=False, checkpoint=str(sam_checkpoint))
+    outcome = run_bench(
+        tiny_manifest,
+        out,
+        ["samvg", "samvg-nofilter", "diffvg", "live"],
+        config=config,
+        limit=1,
+        lpips_weights=lpips_file,
+        report=False,
+        **TINY,
+    )
+    assert outcome.failed == 0, read_rows(out)
+    rows = {r["method"]: r for r in read_rows(out)}
+    paths = int(rows["samvg"]["paths"])
+    assert paths >= 1 and rows["diffvg"]["paths"] == rows["live"]["paths"] == str(paths)
+    assert float(rows["samvg"]["mse"]) < 0.1
+    assert np.isfinite(float(rows["samvg-nofilter"]["lpips"]))
