@@ -1,13 +1,21 @@
-"""The ``samvg`` command line: vectorize, segment and render, with progress and plain errors."""
+"""The ``samvg`` command line: vectorize images (one, or a folder/glob in a batch), show SAM's
+masks, render SVG; with progress, a closing summary and one-line errors.
+"""
 
 from __future__ import annotations
 
 import argparse
+import glob
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from samvg.errors import SamvgError
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
+SUBCOMMANDS = ("vectorize", "segment", "render")
 
 
 def _say(console, text: str) -> None:  # type: ignore[no-untyped-def]
@@ -15,25 +23,43 @@ def _say(console, text: str) -> None:  # type: ignore[no-untyped-def]
     console.print(text, markup=False, highlight=False, soft_wrap=True)
 
 
-def _progress_reporter(console):  # type: ignore[no-untyped-def]
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+class _StageProgress:
+    """Rich progress bars, one per pipeline stage, with ETA; silent when ``quiet``."""
 
-    progress = Progress(
-        TextColumn("{task.description:<10}"),
-        BarColumn(),
-        TextColumn("{task.completed}/{task.total}"),
-        TimeElapsedColumn(),
-        console=console,
-        transient=False,
-    )
-    tasks: dict[str, int] = {}
+    def __init__(self, console, quiet: bool) -> None:  # type: ignore[no-untyped-def]
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
 
-    def report(stage: str, done: int, total: int) -> None:
-        if stage not in tasks:
-            tasks[stage] = progress.add_task(stage, total=total)
-        progress.update(tasks[stage], completed=done, total=total)
+        self.progress = Progress(
+            TextColumn("{task.description:<14}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            TextColumn("eta"),
+            TimeRemainingColumn(),
+            console=console,
+            transient=True,
+            disable=quiet,
+        )
+        self.tasks: dict[str, Any] = {}
+        self.prefix = ""
 
-    return progress, report
+    def report(self, stage: str, done: int, total: int) -> None:
+        key = self.prefix + stage
+        if key not in self.tasks:
+            self.tasks[key] = self.progress.add_task(key, total=total)
+        self.progress.update(self.tasks[key], completed=done, total=total)
+
+    def clear(self) -> None:
+        for task in self.tasks.values():
+            self.progress.remove_task(task)
+        self.tasks = {}
 
 
 def _check_output(path: Path, suffixes: tuple[str, ...]) -> None:
@@ -43,50 +69,198 @@ def _check_output(path: Path, suffixes: tuple[str, ...]) -> None:
         raise SamvgError(f"output folder {path.parent} does not exist")
 
 
-def _vectorize(arguments: argparse.Namespace, console) -> None:  # type: ignore[no-untyped-def]
-    from samvg.io import read_image, write_png
-    from samvg.pipeline import VectorizeConfig, vectorize
+def _config(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
+    from samvg.config import Config
 
-    _check_output(arguments.output, (".svg",))
+    settings: dict[str, Any] = {
+        "model": arguments.model,
+        "checkpoint": arguments.checkpoint,
+        "seed": arguments.seed,
+        "device": arguments.device,
+    }
+    optional = {
+        "max_paths": arguments.max_paths,
+        "segments": arguments.segments,
+        "iterations": arguments.iterations,
+        "size": arguments.size,
+        "crop_n_layers": arguments.crops,
+        "lpips_weights": arguments.lpips_weights,
+    }
+    settings.update({key: value for key, value in optional.items() if value is not None})
+    if arguments.no_lpips:
+        settings["use_lpips"] = False
+    if arguments.no_filter:
+        settings["filter_by_impact"] = False
+    return Config.fast(**settings) if arguments.fast else Config(**settings)
+
+
+def _expand_inputs(inputs: list[str]) -> tuple[list[Path], bool]:
+    """Image files named by the arguments (files, folders, glob patterns); True if a batch."""
+    found: list[Path] = []
+    batch = len(inputs) > 1
+    for text in inputs:
+        path = Path(text)
+        if path.is_dir():
+            batch = True
+            found.extend(sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES))
+        elif path.exists() or not glob.has_magic(text):
+            found.append(path)
+        else:
+            batch = True
+            found.extend(
+                sorted(Path(p) for p in glob.glob(text) if Path(p).suffix.lower() in IMAGE_SUFFIXES)
+            )
+    if not found:
+        raise SamvgError(f"no images found in {' '.join(inputs)}")
+    return found, batch
+
+
+def _vectorize(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-untyped-def]
+    config = _config(arguments)
+    inputs, batch = _expand_inputs(arguments.input)
+    if not batch:
+        _check_output(arguments.output, (".svg",))
+        if arguments.preview is not None:
+            _check_output(arguments.preview, (".png",))
+        progress = _StageProgress(console, arguments.quiet)
+        with progress.progress:
+            _vectorize_one(
+                inputs[0], arguments.output, arguments.preview, config, arguments, progress, console
+            )
+        return 0
+
+    output_folder: Path = arguments.output
+    if output_folder.suffix.lower() == ".svg":
+        raise SamvgError(f"several inputs: -o must be a folder, not {output_folder}")
     if arguments.preview is not None:
-        _check_output(arguments.preview, (".png",))
-    config = VectorizeConfig(
-        checkpoint=arguments.checkpoint,
-        model=arguments.model,
-        steps=arguments.steps,
-        max_paths=arguments.max_paths,
-        num_segments=arguments.segments,
+        raise SamvgError("--preview takes one input; in a batch use --save-stages DIR")
+    output_folder.mkdir(parents=True, exist_ok=True)
+    failures: list[tuple[Path, str]] = []
+    done = skipped = 0
+    progress = _StageProgress(console, arguments.quiet)
+    with progress.progress:
+        overall = progress.progress.add_task("images", total=len(inputs))
+        for source in inputs:
+            target = output_folder / (source.stem + ".svg")
+            if target.exists() and not arguments.overwrite:
+                skipped += 1
+                progress.progress.advance(overall)
+                continue
+            progress.prefix = f"{source.stem[:8]} "
+            try:
+                _vectorize_one(source, target, None, config, arguments, progress, console)
+                done += 1
+            except SamvgError as error:
+                failures.append((source, str(error).splitlines()[0]))
+                _say(console, f"failed {source}: {failures[-1][1]}")
+            except Exception as error:  # noqa: BLE001 - one bad image must not stop a batch
+                failures.append((source, f"internal error {type(error).__name__}: {error}"))
+                _say(console, f"failed {source}: {failures[-1][1]}")
+            progress.clear()
+            progress.progress.advance(overall)
+    _say(
+        console,
+        f"batch: {done} vectorized, {skipped} skipped (already done), {len(failures)} failed",
     )
-    image = read_image(arguments.input)
-    progress, report = _progress_reporter(console)
-    with progress:
-        result = vectorize(image, config, progress=report)
-    result.save(arguments.output, precision=arguments.precision)
-    _say(console, f"wrote {arguments.output} ({len(result.paths)} paths)")
-    if arguments.preview is not None:
-        write_png(arguments.preview, result.render())
-        _say(console, f"wrote {arguments.preview}")
+    for source, reason in failures:
+        _say(console, f"  {source}: {reason}")
+    return 1 if failures else 0
 
 
-def _segment(arguments: argparse.Namespace, console) -> None:  # type: ignore[no-untyped-def]
+def _vectorize_one(  # type: ignore[no-untyped-def]
+    source: Path, output: Path, preview, config, arguments, progress, console
+) -> None:
+    from samvg.io import write_png
+    from samvg.pipeline import run
+
+    started = time.perf_counter()
+    result = run(source, config, progress=progress.report, log=lambda text: _say(console, text))
+    result.image.save(output, precision=arguments.precision)
+    if preview is not None:
+        write_png(preview, result.image.render())
+    if arguments.save_stages is not None:
+        folder = (
+            arguments.save_stages
+            if not arguments.batch_mode
+            else (arguments.save_stages / source.stem)
+        )
+        _save_stages(result, folder, arguments.precision)
+    if not arguments.quiet:
+        for note in result.notes:
+            _say(console, f"note: {note}")
+        timings = ", ".join(
+            f"{stage} {seconds:.1f}s"
+            for stage, seconds in result.timings.items()
+            if stage != "total"
+        )
+        _say(
+            console,
+            f"wrote {output}: {len(result.image.paths)} paths, MSE {result.mse:.5f}, "
+            f"{time.perf_counter() - started:.1f}s ({timings})",
+        )
+        if preview is not None:
+            _say(console, f"wrote {preview}")
+
+
+def _save_stages(result, folder: Path, precision: int) -> None:  # type: ignore[no-untyped-def]
+    """Intermediate results: masks, initial SVG, SVG after stage 3, stage-4 map, final SVG, and
+    target | initial | optimized | final side by side."""
     import numpy as np
 
+    from samvg.io import write_png
+
+    folder.mkdir(parents=True, exist_ok=True)
+    target = result.target
+    if result.masks:
+        write_png(folder / "1_masks.png", mask_overlay(target, result.masks))
+    renders = [target]
+    for name, image in (("2_initial", result.initial), ("3_optimized", result.optimized)):
+        if image is not None:
+            image.save(folder / f"{name}.svg", precision=precision)
+            renders.append(image.render(scale=result.scale))
+    if result.missing_map is not None:
+        heat = np.clip(result.missing_map / 3.0, 0.0, 1.0)
+        picture = np.stack([heat, heat * 0.3, 1.0 - heat], axis=2)
+        for x, y in result.missing_prompts:
+            picture[max(0, int(y) - 2) : int(y) + 3, max(0, int(x) - 2) : int(x) + 3] = (1, 1, 1)
+        write_png(folder / "4_missing.png", picture)
+    result.image.save(folder / "5_final.svg", precision=precision)
+    renders.append(result.image.render(scale=result.scale))
+    height = min(r.shape[0] for r in renders)
+    width = min(r.shape[1] for r in renders)
+    write_png(folder / "comparison.png", np.concatenate([r[:height, :width] for r in renders], 1))
+
+
+def mask_overlay(image, masks, seed: int = 0):  # type: ignore[no-untyped-def]
+    """The image dimmed, each mask tinted with its own random colour (paint order)."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    overlay = np.asarray(image, dtype=np.float32).copy()
+    if overlay.dtype != np.float32 or overlay.max() > 1.0:
+        overlay = overlay / 255.0
+    for mask in masks:
+        overlay[mask] = 0.45 * overlay[mask] + 0.55 * rng.uniform(0, 1, 3)
+    return overlay
+
+
+def _segment(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-untyped-def]
+    from samvg.config import Config
     from samvg.io import read_image, write_png
-    from samvg.pipeline import VectorizeConfig, segment
+    from samvg.segment import Segmenter
 
     _check_output(arguments.output, (".png",))
     image = read_image(arguments.input)
+    config = Config(checkpoint=arguments.checkpoint, model=arguments.model)
     with console.status("segmenting"):
-        masks = segment(image, VectorizeConfig(checkpoint=arguments.checkpoint, max_paths=10**9))
-    rng = np.random.default_rng(0)
-    overlay = image.astype(np.float32) / 255.0
-    for mask in masks:
-        overlay[mask] = 0.45 * overlay[mask] + 0.55 * rng.uniform(0, 1, 3)
-    write_png(arguments.output, overlay)
+        masks = Segmenter(config).automatic(image)
+    masks.sort(key=lambda m: -int(m.sum()))
+    write_png(arguments.output, mask_overlay(image, masks))
     _say(console, f"wrote {arguments.output} ({len(masks)} masks)")
+    return 0
 
 
-def _render(arguments: argparse.Namespace, console) -> None:  # type: ignore[no-untyped-def]
+def _render(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-untyped-def]
     from samvg.io import write_png
     from samvg.vector_image import VectorImage
 
@@ -94,28 +268,77 @@ def _render(arguments: argparse.Namespace, console) -> None:  # type: ignore[no-
     image = VectorImage.load(arguments.input)
     write_png(arguments.output, image.render(scale=arguments.scale))
     _say(console, f"wrote {arguments.output}")
+    return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``samvg`` command."""
-    parser = argparse.ArgumentParser(prog="samvg", description=__doc__)
+    parser = argparse.ArgumentParser(
+        prog="samvg",
+        description="Raster images to compact, editable SVG (SAMVG). "
+        "`samvg INPUT -o OUT.svg` is short for `samvg vectorize INPUT -o OUT.svg`.",
+    )
     commands = parser.add_subparsers(dest="command", required=True)
 
-    vectorize = commands.add_parser("vectorize", help="raster image to SVG")
-    vectorize.add_argument("input", type=Path)
-    vectorize.add_argument("-o", "--output", type=Path, required=True, help="SVG file to write")
+    vectorize = commands.add_parser(
+        "vectorize",
+        help="raster image(s) to SVG",
+        description="Vectorize an image, or a batch (folder, glob or several files) into a folder.",
+    )
+    vectorize.add_argument("input", nargs="+", help="image file(s), folder or glob pattern")
+    vectorize.add_argument(
+        "-o", "--output", type=Path, required=True, help="SVG file (one input) or output folder"
+    )
     vectorize.add_argument("--preview", type=Path, help="also write a PNG render of the result")
-    vectorize.add_argument("--model", default="mobile_sam", help="SAM variant (default mobile_sam)")
+    vectorize.add_argument(
+        "--save-stages",
+        type=Path,
+        metavar="DIR",
+        help="write every stage's result (masks, SVGs, maps) into DIR",
+    )
+    vectorize.add_argument(
+        "--fast",
+        action="store_true",
+        help="quick preset: 16x16 grid, 384 px, 120 steps a phase, no LPIPS",
+    )
+    vectorize.add_argument("--max-paths", type=int, help="at most this many paths")
+    vectorize.add_argument("--segments", type=int, help="cubic segments per path (default 5)")
+    vectorize.add_argument(
+        "--iterations", type=int, help="optimization steps per phase (default 500, two phases)"
+    )
+    vectorize.add_argument(
+        "--size",
+        type=int,
+        help="working resolution, longest side (default 512); the SVG keeps "
+        "the input's pixel coordinates",
+    )
+    vectorize.add_argument("--seed", type=int, default=0)
+    vectorize.add_argument("--device", default="cpu")
+    vectorize.add_argument(
+        "--model",
+        default="mobile_sam",
+        help="SAM variant: mobile_sam (default), vit_b, vit_l, vit_h",
+    )
     vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
-    vectorize.add_argument("--steps", type=int, default=300, help="optimisation steps")
-    vectorize.add_argument("--max-paths", type=int, default=64)
-    vectorize.add_argument("--segments", type=int, default=5, help="cubic segments per path")
+    vectorize.add_argument("--crops", type=int, help="SAM crop layers (test-time augmentation)")
+    vectorize.add_argument("--no-lpips", action="store_true", help="optimize MSE + Xing only")
+    vectorize.add_argument("--lpips-weights", help="LPIPS weight file (flat state dict)")
+    vectorize.add_argument(
+        "--no-filter",
+        action="store_true",
+        help="keep every SAM mask (the paper's ablation of filter by impact)",
+    )
     vectorize.add_argument("--precision", type=int, default=2, help="decimals in SVG output")
+    vectorize.add_argument(
+        "--overwrite", action="store_true", help="in a batch, redo images whose SVG already exists"
+    )
+    vectorize.add_argument("-q", "--quiet", action="store_true", help="no progress, no summary")
     vectorize.set_defaults(handler=_vectorize)
 
     segment = commands.add_parser("segment", help="SAM automatic masks as a colour overlay PNG")
     segment.add_argument("input", type=Path)
     segment.add_argument("-o", "--output", type=Path, required=True)
+    segment.add_argument("--model", default="mobile_sam")
     segment.add_argument("--checkpoint", help="SAM checkpoint file")
     segment.set_defaults(handler=_segment)
 
@@ -132,17 +355,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     from rich.console import Console
     from rich.markup import escape
 
-    arguments = build_parser().parse_args(argv)
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args and args[0] not in SUBCOMMANDS and args[0] not in ("-h", "--help"):
+        args.insert(0, "vectorize")
+    arguments = build_parser().parse_args(args)
+    arguments.batch_mode = False
     console = Console(stderr=True)
     try:
-        arguments.handler(arguments, console)
+        if arguments.command == "vectorize":
+            arguments.batch_mode = _expand_inputs(arguments.input)[1]
+        return int(arguments.handler(arguments, console) or 0)
     except SamvgError as error:
         console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, soft_wrap=True)
+        return 1
+    except MemoryError:
+        console.print("[bold red]error:[/] out of memory; try a smaller --size", highlight=False)
         return 1
     except KeyboardInterrupt:
         console.print("interrupted")
         return 130
-    return 0
 
 
 if __name__ == "__main__":

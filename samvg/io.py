@@ -8,7 +8,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
+from PIL import Image, ImageOps
 
 from samvg.errors import InputError
 
@@ -119,7 +119,8 @@ def _to_unit_float(arr: np.ndarray) -> np.ndarray:
 
 
 def read_image(path: str | os.PathLike[str]) -> np.ndarray:
-    """Read an image file as uint8 RGB (H, W, 3); transparency is composited over white.
+    """Read an image file as uint8 RGB (H, W, 3), turned upright by its EXIF orientation;
+    transparency is composited over white, CMYK/palette/16-bit converted.
 
     Raises :class:`InputError` for a missing, unreadable, corrupt or empty file.
     """
@@ -131,7 +132,8 @@ def read_image(path: str | os.PathLike[str]) -> np.ndarray:
     try:
         with Image.open(source) as opened:
             opened.load()
-            return to_rgb_uint8(opened)
+            upright = ImageOps.exif_transpose(opened)
+            return to_rgb_uint8(upright if upright is not None else opened)
     except (
         UnidentifiedImageError,
         Image.DecompressionBombError,

@@ -1,123 +1,307 @@
-"""The vectorization pipeline: segment with SAM, trace masks into paths, fit them to the image."""
+"""The SAMVG pipeline: segment (stage 1), trace (2), optimize (3), add missing components and
+optimize again (4). `run` returns every intermediate result; `vectorize` just the SVG.
+"""
 
 from __future__ import annotations
 
+import os
+import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from samvg.errors import InputError
-from samvg.io import to_rgb_uint8
+from samvg.config import Config
+from samvg.errors import InputError, SamvgError, WeightsError
+from samvg.io import read_image, to_rgb_uint8
 from samvg.vector_image import VectorImage, VectorPath
 
 ProgressCallback = Callable[[str, int, int], None]
 """``progress(stage, done, total)``: called as each stage advances."""
 
+STAGES = ("segment", "trace", "optimize", "missing", "refine")
+UNIFORM_TOLERANCE = 1.5 / 255.0
+MIN_WORKING_SIDE = 8
+
 
 @dataclass
-class VectorizeConfig:
-    """Settings of :func:`vectorize`; the defaults follow the paper where it gives a value."""
+class PipelineResult:
+    """The final SVG and what the stages produced on the way (working-resolution images)."""
 
-    model: str = "mobile_sam"
-    checkpoint: str | None = None
-    points_per_side: int = 32
-    num_segments: int = 5
-    max_paths: int = 64
-    min_area_fraction: float = 0.0005
-    steps: int = 300
-    max_side: int = 512
-
-    def __post_init__(self) -> None:
-        minimums = {
-            "points_per_side": 1,
-            "num_segments": 1,
-            "max_paths": 1,
-            "steps": 0,
-            "max_side": 8,
-        }
-        for name, smallest in minimums.items():
-            value = getattr(self, name)
-            if not isinstance(value, int) or value < smallest:
-                raise InputError(
-                    f"{name.replace('_', ' ')} must be an integer >= {smallest}, got {value!r}"
-                )
-        if not 0.0 <= self.min_area_fraction < 1.0:
-            raise InputError(f"min area fraction must be in [0, 1), got {self.min_area_fraction}")
+    image: VectorImage
+    initial: VectorImage | None = None
+    optimized: VectorImage | None = None
+    target: np.ndarray | None = None
+    masks: list[np.ndarray] = field(default_factory=list)
+    missing_map: np.ndarray | None = None
+    missing_prompts: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    scale: float = 1.0
+    timings: dict[str, float] = field(default_factory=dict)
+    counts: dict[str, int] = field(default_factory=dict)
+    mse: float = float("nan")
+    notes: list[str] = field(default_factory=list)
 
 
-def _downscale(image: np.ndarray, max_side: int) -> tuple[np.ndarray, float]:
+def load_input(image: Any) -> np.ndarray:
+    """A path or an in-memory image (numpy array or PIL image) as (H, W, 3) uint8 RGB."""
+    if isinstance(image, (str, os.PathLike)):
+        return read_image(image)
+    return to_rgb_uint8(image)
+
+
+def working_image(original: np.ndarray, size: int) -> tuple[np.ndarray, float]:
+    """Downscale so the longer side is at most ``size`` (Lanczos); returns (image, scale)."""
     from PIL import Image
 
-    height, width = image.shape[:2]
-    scale = min(1.0, max_side / max(height, width))
+    height, width = original.shape[:2]
+    scale = min(1.0, size / max(height, width))
     if scale == 1.0:
-        return image, 1.0
-    size = (max(2, round(width * scale)), max(2, round(height * scale)))
-    resized = np.asarray(Image.fromarray(image).resize(size, Image.Resampling.LANCZOS))
-    return resized, size[0] / width
+        return original, 1.0
+    new_size = (max(2, round(width * scale)), max(2, round(height * scale)))
+    resized = np.asarray(Image.fromarray(original).resize(new_size, Image.Resampling.LANCZOS))
+    return resized, new_size[0] / width
 
 
-def segment(image: np.ndarray, config: VectorizeConfig) -> list[np.ndarray]:
-    """SAM automatic masks of ``image`` (uint8 RGB), largest first, small ones dropped."""
-    from samvg.sam import SamAutomaticMaskGenerator, load_sam
+def fit_options(config: Config, target: np.ndarray | None = None) -> dict[str, Any]:
+    """The keyword arguments of `samvg.optimize.fit_paths` for one optimization phase.
 
-    model = load_sam(config.model, checkpoint=config.checkpoint)
-    generator = SamAutomaticMaskGenerator(model, points_per_side=config.points_per_side)
-    records = generator.generate(image)
-    minimum = config.min_area_fraction * image.shape[0] * image.shape[1]
-    masks = [r["segmentation"] for r in records if r["area"] >= max(minimum, 4)]
-    masks.sort(key=lambda m: int(m.sum()), reverse=True)
-    return masks[: config.max_paths]
+    With ``target`` and ``config.use_lpips`` the LPIPS loss is loaded and bound to it (raises
+    `WeightsError` when its weights cannot be found); baselines use this to run with exactly
+    the losses and budget samvg uses.
+    """
+    options: dict[str, Any] = {
+        "steps": config.iterations,
+        "point_learning_rate": config.point_learning_rate,
+        "colour_learning_rate": config.colour_learning_rate,
+        "xing_weight": config.xing_weight,
+    }
+    if target is not None and config.use_lpips and config.lpips_weight > 0:
+        options["lpips"] = perceptual_loss(target, config)
+        options["lpips_weight"] = config.lpips_weight
+    return options
+
+
+def perceptual_loss(target: np.ndarray, config: Config) -> Callable:
+    """LPIPS of a render against ``target``, both resized to ``config.lpips_size`` (long side)."""
+    import torch
+    import torch.nn.functional as functional
+
+    from samvg.metrics import load_lpips
+
+    model = load_lpips(config.lpips_weights)
+    height, width = target.shape[:2]
+    factor = min(1.0, config.lpips_size / max(height, width))
+    size = (max(16, round(height * factor)), max(16, round(width * factor)))
+
+    def prepare(image: torch.Tensor) -> torch.Tensor:
+        batch = image.permute(2, 0, 1)[None]
+        if size != (height, width):
+            batch = functional.interpolate(batch, size=size, mode="bilinear", antialias=True)
+        return batch
+
+    target_batch = prepare(torch.from_numpy(np.ascontiguousarray(target, dtype=np.float32)))
+
+    def loss(rendered: torch.Tensor) -> torch.Tensor:
+        return model(prepare(rendered), target_batch).mean()
+
+    return loss
+
+
+def run(
+    image: Any,
+    config: Config | None = None,
+    progress: ProgressCallback | None = None,
+    log: Callable[[str], None] | None = None,
+) -> PipelineResult:
+    """Vectorize ``image`` (a path, numpy array or PIL image) with every stage's output kept.
+
+    Raises `InputError` for unusable input and `WeightsError` for missing SAM weights. LPIPS
+    weights that cannot be found only switch the LPIPS term off (noted in ``result.notes``).
+    """
+    import torch
+
+    config = config or Config()
+    report = progress or (lambda _stage, _done, _total: None)
+    say = log or (lambda _text: None)
+    started = time.perf_counter()
+    original = load_input(image)
+    working, scale = working_image(original, config.size)
+    height, width = working.shape[:2]
+    target = working.astype(np.float32) / 255.0
+    result = PipelineResult(image=VectorImage(original.shape[1], original.shape[0]), scale=scale)
+    result.target = target
+
+    mean_colour = tuple(float(v) for v in target.reshape(-1, 3).mean(axis=0))
+    if (
+        min(height, width) < MIN_WORKING_SIDE
+        or np.ptp(target, axis=(0, 1)).max() <= UNIFORM_TOLERANCE
+    ):
+        reason = "tiny" if min(height, width) < MIN_WORKING_SIDE else "uniform"
+        result.notes.append(f"{reason} image: one background colour, no paths")
+        result.image = VectorImage(original.shape[1], original.shape[0], background=mean_colour)
+        result.mse = float(np.mean((target - np.asarray(mean_colour, np.float32)) ** 2))
+        result.timings["total"] = time.perf_counter() - started
+        return result
+
+    torch.manual_seed(config.seed)
+    from samvg.segment import (
+        Segmenter,
+        missing_component_map,
+        missing_component_prompts,
+        missing_masks,
+        select_masks,
+    )
+
+    # Stage 1
+    clock = time.perf_counter()
+    report("segment", 0, 1)
+    segmenter = Segmenter(config)
+    selection = select_masks(working, segmenter, config)
+    report("segment", 1, 1)
+    result.timings["segment"] = time.perf_counter() - clock
+    result.counts.update(
+        amg_masks=selection.amg_masks,
+        kept_masks=selection.kept_after_filter,
+        reprompt_masks=selection.reprompt_masks,
+    )
+    result.masks = selection.masks
+
+    # Stage 2
+    clock = time.perf_counter()
+    min_pixels = max(4.0, config.min_area * height * width)
+    points, colours = _trace(selection.masks, target, config.segments, min_pixels, report)
+    covered = np.zeros((height, width), dtype=bool)
+    for mask in selection.masks:
+        covered |= mask
+    background = (
+        tuple(float(v) for v in target[~covered].mean(axis=0)) if (~covered).any() else mean_colour
+    )
+    result.initial = _to_image(points, colours, background, original.shape, scale)
+    result.timings["trace"] = time.perf_counter() - clock
+    result.counts["paths_initial"] = len(points)
+
+    # Stage 3
+    clock = time.perf_counter()
+    options = fit_options(config)
+    if config.use_lpips and config.lpips_weight > 0 and config.iterations > 0:
+        try:
+            options = fit_options(config, target)
+        except (WeightsError, ImportError) as error:
+            first_line = str(error).splitlines()[0]
+            result.notes.append(f"LPIPS off (MSE + Xing only): {first_line}")
+            say(result.notes[-1])
+    fit = _fit(points, colours, target, background, options, "optimize", report)
+    points, colours = fit.points, fit.colours
+    result.optimized = _to_image(points, colours, background, original.shape, scale)
+    result.timings["optimize"] = time.perf_counter() - clock
+
+    # Stage 4
+    if config.missing_components:
+        clock = time.perf_counter()
+        report("missing", 0, 1)
+        render = _render(points, colours, width, height, background)
+        radius = config.missing_radius * max(height, width)
+        averaged, above = missing_component_map(target, render, radius, config.missing_threshold)
+        prompts = missing_component_prompts(averaged, above)
+        result.missing_map = averaged
+        result.missing_prompts = prompts
+        new_masks = missing_masks(segmenter, prompts, target, render, config)
+        new_points, new_colours = _trace(new_masks, target, config.segments, min_pixels, None)
+        report("missing", 1, 1)
+        result.counts["missing_prompts"] = len(prompts)
+        result.counts["missing_paths"] = len(new_points)
+        result.timings["missing"] = time.perf_counter() - clock
+        if len(new_points):
+            clock = time.perf_counter()
+            points = np.concatenate([points, new_points])
+            colours = np.concatenate([colours, new_colours])
+            fit = _fit(points, colours, target, background, options, "refine", report)
+            points, colours = fit.points, fit.colours
+            result.timings["refine"] = time.perf_counter() - clock
+
+    result.image = _to_image(points, colours, background, original.shape, scale)
+    result.mse = float(np.mean((_render(points, colours, width, height, background) - target) ** 2))
+    result.counts["paths"] = len(result.image.paths)
+    result.timings["total"] = time.perf_counter() - started
+    return result
 
 
 def vectorize(
-    image: np.ndarray,
-    config: VectorizeConfig | None = None,
-    progress: ProgressCallback | None = None,
+    image: Any, config: Config | None = None, progress: ProgressCallback | None = None
 ) -> VectorImage:
-    """Vectorize an RGB image (any layout :func:`samvg.io.to_rgb_uint8` accepts) into SVG paths."""
-    from samvg.optimize import fit_paths
+    """Vectorize ``image`` (a path, numpy array or PIL image) into a `VectorImage`.
+
+    The SVG is in the input's pixel coordinates whatever the working size; same input, config
+    and machine give the same SVG.
+    """
+    return run(image, config, progress).image
+
+
+def _trace(
+    masks: list[np.ndarray],
+    target: np.ndarray,
+    segments: int,
+    min_pixels: float,
+    report: ProgressCallback | None,
+) -> tuple[np.ndarray, np.ndarray]:
     from samvg.trace import trace_mask
 
-    config = config or VectorizeConfig()
-    report = progress or (lambda _stage, _done, _total: None)
-    original = to_rgb_uint8(image)
-    working, scale = _downscale(original, config.max_side)
-    height, width = working.shape[:2]
-    target = working.astype(np.float32) / 255.0
-
-    report("segment", 0, 1)
-    masks = segment(working, config)
-    report("segment", 1, 1)
-
-    covered = np.zeros((height, width), dtype=bool)
     points, colours = [], []
     for index, mask in enumerate(masks):
-        report("trace", index, len(masks))
+        if report is not None:
+            report("trace", index, len(masks))
+        if mask.sum() < min_pixels:
+            continue
         try:
-            points.append(trace_mask(mask, config.num_segments))
+            points.append(trace_mask(mask, segments))
         except InputError:
             continue
         colours.append([*target[mask].mean(axis=0), 1.0])
-        covered |= mask
-    report("trace", len(masks), len(masks))
-    background = tuple(target[~covered].mean(axis=0)) if (~covered).any() else (1.0, 1.0, 1.0)
-
-    point_array = np.asarray(points).reshape(len(points), 3 * config.num_segments, 2)
-    colour_array = np.asarray(colours, dtype=np.float64).reshape(len(colours), 4)
-    result = fit_paths(
-        point_array,
-        colour_array,
-        target,
-        steps=config.steps,
-        background=background,
-        on_step=lambda step, _loss: report("optimize", step + 1, config.steps),
+    if report is not None:
+        report("trace", len(masks), len(masks))
+    return (
+        np.asarray(points, dtype=np.float64).reshape(len(points), 3 * segments, 2),
+        np.asarray(colours, dtype=np.float64).reshape(len(colours), 4),
     )
-    if not np.all(np.isfinite(result.points)):
-        raise InputError("optimisation diverged (non-finite coordinates)")
+
+
+def _fit(points, colours, target, background, options, stage, report):  # type: ignore[no-untyped-def]
+    from samvg.optimize import fit_paths
+
+    steps = options["steps"]
+    fit = fit_paths(
+        points,
+        colours,
+        target,
+        background=background,
+        on_step=lambda step, _loss: report(stage, step + 1, steps),
+        **options,
+    )
+    if not (np.all(np.isfinite(fit.points)) and np.all(np.isfinite(fit.colours))):
+        raise SamvgError("optimization diverged (non-finite coordinates); try fewer iterations")
+    return fit
+
+
+def _render(points, colours, width, height, background) -> np.ndarray:  # type: ignore[no-untyped-def]
+    import torch
+
+    from samvg.render import rasterize
+
+    with torch.no_grad():
+        image = rasterize(
+            torch.from_numpy(points).float(),
+            torch.from_numpy(colours).float(),
+            width,
+            height,
+            background=background,
+        )
+    return image.numpy()
+
+
+def _to_image(points, colours, background, shape, scale) -> VectorImage:  # type: ignore[no-untyped-def]
     paths = [
         VectorPath(p / scale, tuple(np.clip(c, 0.0, 1.0)))
-        for p, c in zip(result.points, result.colours, strict=True)
+        for p, c in zip(points, colours, strict=True)
     ]
-    return VectorImage(original.shape[1], original.shape[0], paths, background=background)
+    return VectorImage(shape[1], shape[0], paths, background=background)

@@ -88,8 +88,9 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
             str(preview),
             "--checkpoint",
             str(sam_checkpoint),
-            "--steps",
-            "150",
+            "--iterations",
+            "60",
+            "--no-lpips",
         ]
     )
     assert code == 0
@@ -107,8 +108,9 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
     ("option", "message"),
     [
         (["--model", "vit_q"], "unknown SAM model 'vit_q'"),
-        (["--steps", "-3"], "steps must be an integer >= 0"),
-        (["--segments", "0"], "num segments must be an integer >= 1"),
+        (["--iterations", "-3"], "iterations must be an integer >= 0"),
+        (["--segments", "0"], "segments must be an integer >= 1"),
+        (["--size", "4"], "size must be an integer >= 8"),
     ],
 )
 def test_bad_settings_are_clear_errors(tmp_path, capsys, option, message):

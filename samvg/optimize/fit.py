@@ -1,5 +1,5 @@
-"""Adam on control points and fill colours against the pixel MSE to the target image, through the
-differentiable rasterizer.
+"""Adam on control points and fill colours through the differentiable rasterizer: loss = MSE to
+the target + λ_Xing · Xing loss + λ_LPIPS · LPIPS (the paper's objective).
 """
 
 from __future__ import annotations
@@ -12,12 +12,16 @@ import numpy as np
 import torch
 
 from samvg.errors import InputError
+from samvg.optimize.losses import xing_loss
 from samvg.render import rasterize
+
+PerceptualLoss = Callable[[torch.Tensor], torch.Tensor]
+"""``loss(rendered)``: a differentiable scalar for an (H, W, 3) render (its target bound inside)."""
 
 
 @dataclass
 class FitResult:
-    """Optimised ``points`` (P, 3K, 2), ``colours`` (P, 4) and the MSE after each step."""
+    """Optimised ``points`` (P, 3K, 2), ``colours`` (P, 4) and the total loss after each step."""
 
     points: np.ndarray
     colours: np.ndarray
@@ -48,10 +52,15 @@ def fit_paths(
     colour_learning_rate: float = 0.01,
     background: tuple[float, float, float] = (1.0, 1.0, 1.0),
     on_step: Callable[[int, float], None] | None = None,
+    xing_weight: float = 0.0,
+    lpips: PerceptualLoss | None = None,
+    lpips_weight: float = 0.0,
 ) -> FitResult:
     """Fit paths to ``target`` (H, W, 3) float in [0, 1] for ``steps`` Adam steps.
 
-    ``on_step(step, loss)`` is called after every step (progress reporting).
+    ``lpips`` is a perceptual loss of the render (see `PerceptualLoss`), weighted by
+    ``lpips_weight``; ``on_step(step, loss)`` is called after every step (progress reporting).
+    Colours are clamped to [0, 1] after every step.
     """
     target_array = np.asarray(target, dtype=np.float32)
     if target_array.ndim != 3 or target_array.shape[2] != 3:
@@ -75,6 +84,10 @@ def fit_paths(
                     point_tensor, colour_tensor, width, height, background=background
                 )
                 loss = torch.mean((rendered - target_tensor) ** 2)
+                if xing_weight > 0:
+                    loss = loss + xing_weight * xing_loss(point_tensor)
+                if lpips is not None and lpips_weight > 0:
+                    loss = loss + lpips_weight * lpips(rendered)
                 loss.backward()
                 optimizer.step()
                 with torch.no_grad():

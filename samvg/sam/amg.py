@@ -83,6 +83,8 @@ class SamAutomaticMaskGenerator:
         self.min_mask_region_area = min_mask_region_area
         self.mask_batch = max(1, int(mask_batch))
         self.timings: dict[str, float] = {}
+        self.image_embedding: torch.Tensor | None = None
+        """The whole image's embedding from the last `generate` (reuse it to prompt again)."""
 
     @torch.inference_mode()
     def generate(self, image) -> list[dict[str, Any]]:
@@ -95,6 +97,7 @@ class SamAutomaticMaskGenerator:
 
         img = to_rgb_uint8(image)
         self.timings = {"encoder": 0.0, "decoder": 0.0, "masks": 0.0, "post": 0.0}
+        self.image_embedding = None
         orig_size = (img.shape[0], img.shape[1])
         crop_boxes, layer_idxs = generate_crop_boxes(
             orig_size, self.crop_n_layers, self.crop_overlap_ratio
@@ -208,6 +211,8 @@ class SamAutomaticMaskGenerator:
         data["crop_boxes"] = torch.tensor([crop_box] * len(data["iou"]), dtype=torch.long).view(
             -1, 4
         )
+        if crop_box == [0, 0, orig_w, orig_h]:
+            self.image_embedding = pred.get_image_embedding()
         pred.reset_image()
         self.timings["post"] += time.perf_counter() - t0
         return data
