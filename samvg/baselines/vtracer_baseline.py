@@ -11,6 +11,7 @@ import io
 import math
 import os
 import re
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,6 +39,8 @@ class TracedSvg:
     height: int
     settings: dict[str, int] = field(default_factory=dict)
     evaluations: int = 1
+    run_seconds: float = 0.0
+    """Time of the one VTracer run that made ``svg`` (the search took ``evaluations`` runs)."""
 
     @property
     def path_count(self) -> int:
@@ -106,12 +109,18 @@ def trace_once(png: bytes, filter_speckle: int, color_precision: int, layer_diff
     )
 
 
-def vtracer_trace(target: np.ndarray, path_count: int, max_evaluations: int = 48) -> TracedSvg:
+def vtracer_trace(
+    target: np.ndarray,
+    path_count: int,
+    max_evaluations: int = 48,
+    tolerance: float = 0.02,
+) -> TracedSvg:
     """VTracer's SVG of ``target`` with a path count as close to ``path_count`` as found.
 
     For each (color_precision, layer_difference) of :data:`SETTINGS_GRID`, filter_speckle is
-    bisected on a log scale (path counts fall as it grows); the search stops at an exact match
-    or after ``max_evaluations`` runs, and keeps the closest result (the first one on ties).
+    bisected on a log scale (path counts fall as it grows); the search stops once a count is
+    within ``tolerance`` × ``path_count`` (rounded down, so exact below 50 paths) or after
+    ``max_evaluations`` runs, and keeps the closest result (the first one on ties).
     """
     from PIL import Image
 
@@ -121,14 +130,18 @@ def vtracer_trace(target: np.ndarray, path_count: int, max_evaluations: int = 48
     buffer = io.BytesIO()
     Image.fromarray(image).save(buffer, format="PNG")
     png = buffer.getvalue()
+    good_enough = int(tolerance * path_count)
     cache: dict[tuple[int, int, int], str] = {}
+    seconds: dict[tuple[int, int, int], float] = {}
     best: tuple[int, tuple[int, int, int]] | None = None
 
     def count(speckle: int, precision: int, difference: int) -> int:
         nonlocal best
         key = (speckle, precision, difference)
         if key not in cache:
+            started = time.perf_counter()
             cache[key] = trace_once(png, speckle, precision, difference)
+            seconds[key] = time.perf_counter() - started
         found = len(re.findall(r"<path\b", cache[key]))
         if best is None or abs(found - path_count) < best[0]:
             best = (abs(found - path_count), key)
@@ -136,7 +149,7 @@ def vtracer_trace(target: np.ndarray, path_count: int, max_evaluations: int = 48
 
     low_bound, high_bound = SPECKLE_RANGE
     for precision, difference in SETTINGS_GRID:
-        if len(cache) >= max_evaluations or (best is not None and best[0] == 0):
+        if len(cache) >= max_evaluations or (best is not None and best[0] <= good_enough):
             break
         low, high = low_bound, high_bound
         if count(low, precision, difference) <= path_count:
@@ -146,7 +159,7 @@ def vtracer_trace(target: np.ndarray, path_count: int, max_evaluations: int = 48
         while high - low > 1 and len(cache) < max_evaluations:
             middle = min(high - 1, max(low + 1, round(math.sqrt(low * high))))
             found = count(middle, precision, difference)
-            if found == path_count:
+            if abs(found - path_count) <= good_enough:
                 break
             if found > path_count:
                 low = middle
@@ -164,4 +177,5 @@ def vtracer_trace(target: np.ndarray, path_count: int, max_evaluations: int = 48
             "layer_difference": difference,
         },
         evaluations=len(cache),
+        run_seconds=seconds[best[1]],
     )

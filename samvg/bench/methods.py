@@ -80,7 +80,11 @@ def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:
         if name == "vtracer":
             result = run_baseline(name, job.target, max(1, job.path_count))
             assert isinstance(result, TracedSvg)
-            job.details.update(settings=result.settings, evaluations=result.evaluations)
+            job.details.update(
+                settings=result.settings,
+                evaluations=result.evaluations,
+                single_run_s=round(result.run_seconds, 3),
+            )
             return result
         phases = SAMVG_PHASES if job.config.missing_components else 1
         steps = phases * job.config.iterations
