@@ -368,6 +368,17 @@ def lpips_weights_path(
         raise WeightsError(f"{not_found}\n{e}") from None
 
 
+def _check_images(x: torch.Tensor) -> None:
+    if not isinstance(x, torch.Tensor) or x.dim() != 4 or x.shape[1] != 3:
+        shape = tuple(x.shape) if isinstance(x, torch.Tensor) else type(x).__name__
+        raise InputError(f"LPIPS needs (N, 3, H, W) tensors of one shape, got {shape}")
+    if min(x.shape[2:]) < MIN_SIZE:
+        raise InputError(
+            f"LPIPS needs images of at least {MIN_SIZE}x{MIN_SIZE} pixels (AlexNet's two "
+            f"pooling stages), got {tuple(x.shape)}"
+        )
+
+
 class LPIPS(nn.Module):
     """LPIPS v0.1 (AlexNet) distance; ``forward(x, y)`` with (N,3,H,W) in [0,1] -> (N,)."""
 
@@ -397,8 +408,9 @@ class LPIPS(nn.Module):
         self.load_state_dict(mapped, strict=True)
 
     def features(self, x: torch.Tensor) -> list[torch.Tensor]:
-        """The five unit-normalized ReLU feature maps of images already scaled to [-1, 1]."""
-        h = (x - self.shift) / self.scale
+        """The five channel-normalized ReLU feature maps of (N, 3, H, W) images in [0, 1]."""
+        _check_images(x)
+        h = (x.to(self.shift.dtype) * 2 - 1 - self.shift) / self.scale
         out = []
         for n, conv in enumerate(self.convs):
             if n in (1, 2):
@@ -408,25 +420,53 @@ class LPIPS(nn.Module):
             out.append(h / (norm + 1e-10))
         return out
 
+    def distance_from_features(
+        self, fx: Sequence[torch.Tensor], fy: Sequence[torch.Tensor]
+    ) -> torch.Tensor:
+        """LPIPS from two `features` results (batch sizes equal, or one of them 1) -> (N,)."""
+        total = None
+        for a, b, lin in zip(fx, fy, self.lins, strict=True):
+            diff = (a - b).square().mean(dim=(2, 3))  # (N, C): spatial mean first
+            term = diff @ lin.weight.view(-1)  # == 1x1 conv head, then spatial mean
+            total = term if total is None else total + term
+        assert total is not None
+        return total
+
     def forward(self, x: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
-        if x.dim() != 4 or x.shape[1] != 3 or x.shape != y.shape:
+        _check_images(x)
+        if x.shape != y.shape:
             raise InputError(
                 f"LPIPS needs two (N, 3, H, W) tensors of one shape, got {tuple(x.shape)} "
                 f"and {tuple(y.shape)}"
             )
-        if min(x.shape[2:]) < MIN_SIZE:
-            raise InputError(
-                f"LPIPS needs images of at least {MIN_SIZE}x{MIN_SIZE} pixels (AlexNet's two "
-                f"pooling stages), got {tuple(x.shape)}"
-            )
+        grad = torch.is_grad_enabled()
+        if grad and x.requires_grad != y.requires_grad:
+            # a loss against a fixed image: no backward pass through the fixed side
+            fixed, moving = (x, y) if y.requires_grad else (y, x)
+            with torch.no_grad():
+                f_fixed = self.features(fixed)
+            return self.distance_from_features(self.features(moving), f_fixed)
         n = x.shape[0]
-        dtype = self.shift.dtype
-        both = torch.cat([x.to(dtype), y.to(dtype)], dim=0) * 2 - 1
-        total = x.new_zeros(n, dtype=dtype)
-        for f, lin in zip(self.features(both), self.lins, strict=True):
-            diff = (f[:n] - f[n:]).square().mean(dim=(2, 3))  # (N, C): spatial mean first
-            total = total + diff @ lin.weight.view(-1)  # == 1x1 conv then spatial mean
-        return total
+        feats = self.features(torch.cat([x, y], dim=0))  # one pass over both: faster
+        return self.distance_from_features([f[:n] for f in feats], [f[n:] for f in feats])
+
+    def fixed_target(self, target: torch.Tensor) -> Callable[[torch.Tensor], torch.Tensor]:
+        """A loss ``f(x) -> (N,)`` = LPIPS(x, target) with the target's features computed once.
+
+        ``target`` is (1 or N, 3, H, W) in [0, 1]; for an optimisation loop against one image
+        this skips a third of the work of ``model(x, target)`` per step.
+        """
+        with torch.no_grad():
+            f_target = [f.detach() for f in self.features(target)]
+
+        def loss(x: torch.Tensor) -> torch.Tensor:
+            if x.shape[1:] != target.shape[1:]:
+                raise InputError(
+                    f"image {tuple(x.shape)} does not match the target {tuple(target.shape)}"
+                )
+            return self.distance_from_features(self.features(x), f_target)
+
+        return loss
 
     @torch.no_grad()
     def distance_images(self, a: np.ndarray, b: np.ndarray) -> float:

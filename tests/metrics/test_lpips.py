@@ -73,13 +73,21 @@ def test_batch_equals_single_and_matches_literal_formula(model):
     single = torch.cat([model(x[i : i + 1], y[i : i + 1]) for i in range(3)])
     torch.testing.assert_close(batch, single, rtol=1e-5, atol=1e-6)
     # the textbook form: 1x1 conv head on the squared difference, then the spatial mean
-    fx, fy = model.features(x * 2 - 1), model.features(y * 2 - 1)
+    fx, fy = model.features(x), model.features(y)
     literal = sum(
         torch.nn.functional.conv2d((a - b) ** 2, lin.weight).mean(dim=(1, 2, 3))
         for a, b, lin in zip(fx, fy, model.lins, strict=True)
     )
     torch.testing.assert_close(batch, literal, rtol=1e-5, atol=1e-6)
     assert model.distance_images(np.zeros((40, 40, 3), np.uint8), np.zeros((40, 40, 3))) == 0
+    # one side needing gradients (separate passes) and a cached target give the same numbers
+    torch.testing.assert_close(model(x, y.clone().requires_grad_(True)), batch)
+    torch.testing.assert_close(model(x.clone().requires_grad_(True), y), batch)
+    loss = model.fixed_target(y[:1])
+    torch.testing.assert_close(loss(x[:1]), batch[:1])
+    torch.testing.assert_close(loss(x), model(x, y[:1].expand_as(x)))
+    with pytest.raises(InputError, match="does not match the target"):
+        loss(x[:, :, :32])
 
 
 def test_bad_inputs(model):
