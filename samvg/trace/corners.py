@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 #: Smallest turning angle (degrees, over ``reach`` points each way) of a real corner.
-MIN_TURN_DEGREES = 30.0
+MIN_TURN_DEGREES = 45.0
 
 
 def _circular(values: np.ndarray, before: int, after: int) -> np.ndarray:
@@ -61,7 +61,7 @@ def select_corners(
         peak &= score > ext[reach + shift : reach + shift + total]
     candidates = np.flatnonzero(peak & (score >= np.deg2rad(min_turn)))
     candidates = candidates[np.argsort(-score[candidates], kind="stable")]
-    suppression = max(reach, total // (4 * count))
+    suppression = max(reach, total // (2 * count))
     chosen: list[int] = []
     for candidate in candidates:
         if chosen:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 #: Newton reparameterization rounds after the chord-length fit.
-NEWTON_ITERATIONS = 3
+NEWTON_ITERATIONS = 16
 # Ridge weight pulling the inner control points towards the chord's thirds: makes runs of two or
 # three points (no or one interior point) well posed and is negligible otherwise.
 _RIDGE = 1e-6

@@ -141,7 +141,7 @@ def _stretches(contour: np.ndarray, segments: int) -> tuple[np.ndarray, np.ndarr
     lengths = (np.append(corners[1:], corners[0]) - corners) % total
     if segments == 1:
         lengths[:] = total
-    sizes = np.minimum(lengths + 1, MAX_FIT_POINTS)
+    sizes = np.clip(lengths + 1, 2, MAX_FIT_POINTS)  # a repeated corner: a point cubic
     first = np.cumsum(sizes) - sizes
     step = np.arange(int(sizes.sum())) - np.repeat(first, sizes)
     scale = np.repeat(lengths / np.maximum(sizes - 1, 1), sizes)
