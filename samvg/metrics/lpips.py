@@ -49,6 +49,7 @@ from samvg.weights import (
     cache_dir,
     download_weights,
     resolve_weights,
+    verify_file,
 )
 
 __all__ = [
@@ -311,7 +312,7 @@ def download_lpips_weights(
     """Download, verify and convert the LPIPS weights into the flat file ``dest``.
 
     ``dest`` defaults to ``<cache>/lpips_alex.pt``. Each route's files are fetched into the
-    folder of ``dest`` (a file already there under the part's name and size is reused),
+    folder of ``dest`` (a file already there under the part's name and sha256 is reused),
     hashed against their pinned sha256, converted, checked against ``expected_digest``
     (default `LPIPS_ALEX_DIGEST`; None skips it) and saved atomically; downloaded parts are
     deleted afterwards. Raises `WeightsError` listing every failure if no route works.
@@ -326,9 +327,13 @@ def download_lpips_weights(
             paths = []
             for part in route.parts:
                 part_path = target.parent / part.filename
-                if part_path.is_file() and part_path.stat().st_size == part.size:
-                    paths.append(part_path)  # left there by the user or an earlier run: reuse
-                    continue
+                if part_path.is_file():  # left there by the user or an earlier run
+                    try:
+                        verify_file(part, part_path)
+                        paths.append(part_path)
+                        continue
+                    except WeightsError:
+                        pass  # wrong or partial: download it afresh
                 got = download_weights(part, part_path, progress=progress, timeout=timeout)
                 downloaded.append(got)
                 paths.append(got)

@@ -189,9 +189,16 @@ def test_download_first_route_converts_into_cache(file_server, cache, monkeypatc
     routes = _serve_fakes(file_server, state)
     monkeypatch.setattr(lp, "DOWNLOAD_ROUTES", routes)
     monkeypatch.setattr(lp, "LPIPS_ALEX_DIGEST", lp.state_digest(state))
+    # a verified part already in the cache is reused and kept; a wrong one is replaced
+    cache.mkdir(parents=True)
+    wheel = zipfile.ZipFile(io.BytesIO(file_server.files["/lpips-0.1.4-py3-none-any.whl"]))
+    (cache / "lpips_v0.1_alex_heads.pth").write_bytes(wheel.read("lpips/weights/v0.1/alex.pth"))
+    del file_server.files["/lpips-0.1.4-py3-none-any.whl"]
+    (cache / "alexnet-owt-7be5be79.pth").write_bytes(b"junk")
     model = load_lpips(progress=False)
     _assert_loaded(model, state)
-    assert sorted(p.name for p in cache.iterdir()) == ["lpips_alex.pt"]  # parts removed
+    assert sorted(p.name for p in cache.iterdir()) == ["lpips_alex.pt", "lpips_v0.1_alex_heads.pth"]
+    (cache / "lpips_v0.1_alex_heads.pth").unlink()
     # second load: cache hit, the server is not asked again
     file_server.files.clear()
     _assert_loaded(load_lpips(download=False), state)
