@@ -48,6 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--checkpoint", help="SAM checkpoint file")
     parser.add_argument("--lpips-weights", help="LPIPS weights file (else the usual lookup)")
     parser.add_argument("--fid-weights", help="FID Inception weights (else the usual lookup)")
+    parser.add_argument("--no-fid", action="store_true", help="leave FID out of the report")
     parser.add_argument(
         "--retry-failed", action="store_true", help="run again what failed in an earlier run"
     )
@@ -111,7 +112,9 @@ def _run(arguments: argparse.Namespace, console: Any, command: str) -> None:
     from samvg.bench.runner import run_bench
 
     if arguments.report_only:
-        summary = write_report(arguments.out, fid_weights=arguments.fid_weights)
+        summary = write_report(
+            arguments.out, fid_weights=arguments.fid_weights, fid=not arguments.no_fid
+        )
         console.print(f"wrote {summary}", markup=False, highlight=False, soft_wrap=True)
         return
     if arguments.manifest is None:
@@ -136,6 +139,7 @@ def _run(arguments: argparse.Namespace, console: Any, command: str) -> None:
             config=config,
             lpips_weights=arguments.lpips_weights,
             fid_weights=arguments.fid_weights,
+            fid=not arguments.no_fid,
             progress=reporter,
             command=command,
         )

@@ -1,9 +1,8 @@
-"""Scoring one output render against its target with the metrics of :mod:`samvg.metrics`."""
+"""Scoring renders against their targets with :mod:`samvg.metrics`: per image, and FID per set."""
 
 from __future__ import annotations
 
 import os
-from typing import Any
 
 import numpy as np
 
@@ -41,19 +40,39 @@ class Scorer:
         return float(metrics.complexity(np.asarray(target, dtype=np.float32)))
 
 
-def fid_score(
-    renders: list[np.ndarray],
+def fid_scores(
+    renders: dict[str, list[np.ndarray]],
     targets: list[np.ndarray],
     weights: str | os.PathLike[str] | None = None,
-) -> dict[str, Any]:
-    """FID between a method's renders and the targets: ``{"fid": value}``, or ``{"fid": nan,
-    "error": why}`` when it cannot be computed (fewer than two images, no weights ...)."""
+) -> tuple[dict[str, float], list[str]]:
+    """FID of each method's renders against the targets (each list: the same images in the
+    same order).
+
+    The Inception network is loaded and the targets' features computed once. The trace term
+    is computed exactly from the features (``method="nuclear"``): with fewer images than
+    feature dimensions the covariances are singular and pytorch-fid's sqrtm would need an
+    offset. Returns the values (NaN where FID could not be computed) and what went wrong.
+    """
     from samvg import metrics
     from samvg.errors import SamvgError
 
-    if len(renders) < 2:
-        return {"fid": float("nan"), "error": "FID needs at least two images"}
+    values = {method: float("nan") for method in renders}
+    if len(targets) < 2:
+        return values, ["FID needs at least two images with results from every method"]
+    methods = list(renders)
+    everything = list(targets) + [image for method in methods for image in renders[method]]
     try:
-        return {"fid": float(metrics.fid(renders, targets, weights=weights))}
+        model = metrics.load_fid_inception(weights, progress=False)
+        features = metrics.fid_features(model, everything)  # one pass: same batches throughout
     except SamvgError as error:
-        return {"fid": float("nan"), "error": str(error).splitlines()[0]}
+        return values, [f"FID: {str(error).splitlines()[0]}"]
+    count = len(targets)
+    target_features = features[:count]
+    problems = []
+    for index, method in enumerate(methods):
+        own = features[count * (index + 1) : count * (index + 2)]
+        try:
+            values[method] = metrics.frechet_distance(own, target_features, method="nuclear")
+        except SamvgError as error:
+            problems.append(f"FID of {method}: {str(error).splitlines()[0]}")
+    return values, problems

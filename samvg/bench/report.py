@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from samvg.bench.measure import fid_score
+from samvg.bench.measure import fid_scores
 from samvg.bench.methods import DEFAULT_METHODS
 from samvg.bench.runner import Layout
 from samvg.errors import InputError
@@ -127,26 +127,12 @@ def _load_float(path: Path) -> np.ndarray:
 def _fid_by_method(
     layout: Layout, methods: list[str], ids: list[str], weights: str | os.PathLike[str] | None
 ) -> tuple[dict[str, float], list[str]]:
-    values: dict[str, float] = {}
-    problems: list[str] = []
-    if not ids:
-        return {m: float("nan") for m in methods}, problems
     try:
         targets = [_load_float(layout.target(i)) for i in ids]
+        renders = {m: [_load_float(layout.render(m, i)) for i in ids] for m in methods}
     except InputError as error:
         return {m: float("nan") for m in methods}, [f"FID: {error}"]
-    for method in methods:
-        try:
-            renders = [_load_float(layout.render(method, i)) for i in ids]
-        except InputError as error:
-            values[method] = float("nan")
-            problems.append(f"FID of {method}: {error}")
-            continue
-        result = fid_score(renders, targets, weights)
-        values[method] = result["fid"]
-        if "error" in result:
-            problems.append(f"FID of {method}: {result['error']}")
-    return values, problems
+    return fid_scores(renders, targets, weights)
 
 
 def _save_figure(figure: Any, path: Path) -> None:
@@ -239,6 +225,7 @@ def write_report(
     out: str | os.PathLike[str],
     fid_weights: str | os.PathLike[str] | None = None,
     progress: Callable[[str], None] | None = None,
+    fid: bool = True,
 ) -> Path:
     """Write summary.md, time_vs_paths.png, mse_vs_paths.png and contact_sheet.png into
     ``out`` from its records; returns the summary's path."""
@@ -250,10 +237,13 @@ def write_report(
     methods = _method_order(records)
     common = _common_ids(records, methods)
     say("FID")
-    fid, problems = _fid_by_method(layout, methods, common, fid_weights)
+    if fid:
+        fid_values, problems = _fid_by_method(layout, methods, common, fid_weights)
+    else:
+        fid_values, problems = {m: float("nan") for m in methods}, ["FID not computed (--no-fid)"]
     overall = _means(records, methods, set(common))
     for method in methods:
-        overall[method]["fid"] = fid[method]
+        overall[method]["fid"] = fid_values[method]
     all_ids = sorted({r["id"] for r in records})
     lines = ["# samvg-bench summary", ""]
     run_info = _run_info(layout)

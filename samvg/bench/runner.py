@@ -242,6 +242,7 @@ def run_bench(
     config: Config | None = None,
     lpips_weights: str | os.PathLike[str] | None = None,
     fid_weights: str | os.PathLike[str] | None = None,
+    fid: bool = True,
     progress: BenchProgress | None = None,
     method_table: dict[str, Method] | None = None,
     report: bool = True,
@@ -252,7 +253,8 @@ def run_bench(
     ``config`` (default :class:`samvg.Config`) is used with ``size`` and, if given,
     ``iterations`` and ``seed``. Results already in ``out`` are kept and skipped (failed ones
     too unless ``retry_failed``); ``out`` must have been made with the same settings.
-    ``command`` (the command line) is kept in run.json and shown in the summary.
+    ``command`` (the command line) is kept in run.json and shown in the summary; ``fid=False``
+    leaves FID out of the report.
     """
     from samvg import Config
 
@@ -329,7 +331,7 @@ def run_bench(
         from samvg.bench.report import write_report
 
         write_results_csv(layout)
-        write_report(layout.out, fid_weights=fid_weights)
+        write_report(layout.out, fid_weights=fid_weights, fid=fid)
     return outcome
 
 

@@ -195,11 +195,12 @@ def test_report_in_the_papers_layout(tiny_manifest, tmp_path, lpips_file, fid_fi
     for name in ("time_vs_paths.png", "mse_vs_paths.png", "contact_sheet.png"):
         assert (out / name).stat().st_size > 1000
     # the report can be rewritten from the folder alone, by the CLI too
-    assert main(["--out", str(out), "--report-only", "--fid-weights", str(fid_file)]) == 0
-    assert write_report(out, fid_weights=fid_file) == out / "summary.md"
+    assert main(["--out", str(out), "--report-only", "--no-fid"]) == 0
+    assert write_report(out, fid=False) == out / "summary.md"
+    assert "| FID ↓ | n/a | n/a | n/a |" in (out / "summary.md").read_text()
 
 
-def test_cli_runs_and_resumes(tiny_manifest, tmp_path, lpips_file, fid_file, monkeypatch, capsys):
+def test_cli_runs_and_resumes(tiny_manifest, tmp_path, lpips_file, monkeypatch, capsys):
     monkeypatch.setitem(METHODS, "samvg", Method("samvg", stand_in_samvg))
     out = tmp_path / "cli"
     arguments = [
@@ -219,15 +220,15 @@ def test_cli_runs_and_resumes(tiny_manifest, tmp_path, lpips_file, fid_file, mon
         "emoji,icon",
         "--lpips-weights",
         str(lpips_file),
-        "--fid-weights",
-        str(fid_file),
+        "--no-fid",
     ]
     assert main(arguments) == 0
     assert "4 results made, 0 already there, 0 failed" in capsys.readouterr().err
     assert {(r["id"], r["method"]) for r in read_rows(out)} == {
         (i, m) for i in ("cactus", "folder") for m in ("samvg", "vtracer")
     }
-    assert "--methods vtracer" in (out / "summary.md").read_text()
+    summary = (out / "summary.md").read_text()
+    assert "--methods vtracer" in summary and "FID not computed (--no-fid)" in summary
     assert main(arguments) == 0
     assert "0 results made, 4 already there" in capsys.readouterr().err
 
