@@ -1,5 +1,6 @@
 """Synthetic masks for testing and benchmarking the tracer: disks, ellipses, rounded rectangles,
-smooth blobs, L-shapes and stars, plus the IoU of a rendered path against a mask."""
+smooth blobs, L-shapes, stars and random wavy blobs, plus the IoU of a rendered path against a
+mask."""
 
 from __future__ import annotations
 
@@ -69,6 +70,19 @@ def star(size: int = 128, points: int = 5) -> np.ndarray:
             x_at = x0 + (v - y0) * (x1 - x0) / (y1 - y0)
         inside ^= crosses & (u < x_at)
     return inside
+
+
+def random_blobs(count: int, size: int = 512, seed: int = 0) -> np.ndarray:
+    """``count`` wavy blobs (radius 8-150 px, three lobes) at random places: (count, size, size)."""
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[:size, :size]
+    masks = np.empty((count, size, size), dtype=bool)
+    for index in range(count):
+        cx, cy = rng.uniform(0.12 * size, 0.88 * size, 2)
+        angle = np.arctan2(yy - cy, xx - cx)
+        radius = rng.uniform(8, 150) * (1 + 0.2 * np.sin(3 * angle + rng.uniform(0, 6)))
+        masks[index] = (xx - cx) ** 2 + (yy - cy) ** 2 < radius**2
+    return masks
 
 
 SHAPES = {

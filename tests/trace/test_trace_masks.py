@@ -26,6 +26,7 @@ from samvg.trace.synthetic import (
     ellipse,
     iou,
     l_shape,
+    random_blobs,
     render_coverage,
     rounded_rectangle,
     star,
@@ -263,14 +264,8 @@ def test_fit_recovers_a_cubic_from_unevenly_spaced_samples():
 
 
 def test_hundred_masks_at_512_px_are_fast():
+    masks = random_blobs(100, 512)
     rng = np.random.default_rng(0)
-    yy, xx = np.mgrid[:512, :512]
-    masks = []
-    for _ in range(100):
-        cx, cy = rng.uniform(60, 450, 2)
-        angle = np.arctan2(yy - cy, xx - cx)
-        radius = rng.uniform(8, 150) * (1 + 0.2 * np.sin(3 * angle + rng.uniform(0, 6)))
-        masks.append((xx - cx) ** 2 + (yy - cy) ** 2 < radius**2)
     image = rng.integers(0, 256, (512, 512, 3), dtype=np.uint8)
     trace_masks(masks[:1], image)  # compile / load the numba kernel
     start = time.process_time()
