@@ -20,6 +20,7 @@ import os
 import platform
 import statistics
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +36,7 @@ SEGMENTS = (3, 4, 5, 6, 8)
 PHOTOS = ("kodim04", "kodim05", "kodim23")
 
 
-def median_seconds(function, repeats: int) -> float:  # type: ignore[no-untyped-def]
+def median_seconds(function: Callable[[], object], repeats: int) -> float:
     function()
     times = []
     for _ in range(repeats):

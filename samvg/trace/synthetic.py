@@ -15,7 +15,9 @@ def _grid(size: int) -> tuple[np.ndarray, np.ndarray]:
     return xx, yy
 
 
-def _rotated(xx: np.ndarray, yy: np.ndarray, cx: float, cy: float, degrees: float):  # type: ignore[no-untyped-def]
+def _rotated(
+    xx: np.ndarray, yy: np.ndarray, cx: float, cy: float, degrees: float
+) -> tuple[np.ndarray, np.ndarray]:
     angle = np.deg2rad(degrees)
     u, v = xx - cx, yy - cy
     return np.cos(angle) * u + np.sin(angle) * v, -np.sin(angle) * u + np.cos(angle) * v
