@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from samvg.config import Config
-from samvg.errors import InputError, SamvgError, WeightsError
+from samvg.errors import SamvgError, WeightsError
 from samvg.io import read_image, to_rgb_uint8
 from samvg.vector_image import VectorImage, VectorPath
 
@@ -101,9 +101,10 @@ def perceptual_loss(target: np.ndarray, config: Config) -> Callable:
         return batch
 
     target_batch = prepare(torch.from_numpy(np.ascontiguousarray(target, dtype=np.float32)))
+    against_target = model.fixed_target(target_batch)
 
     def loss(rendered: torch.Tensor) -> torch.Tensor:
-        return model(prepare(rendered), target_batch).mean()
+        return against_target(prepare(rendered)).mean()
 
     return loss
 
@@ -245,24 +246,18 @@ def _trace(
     min_pixels: float,
     report: ProgressCallback | None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    from samvg.trace import trace_mask
+    """Every component of every mask as a path: points (P, 3K, 2) and RGBA colours (P, 4)."""
+    from samvg.trace import trace_masks
 
-    points, colours = [], []
-    for index, mask in enumerate(masks):
-        if report is not None:
-            report("trace", index, len(masks))
-        if mask.sum() < min_pixels:
-            continue
-        try:
-            points.append(trace_mask(mask, segments))
-        except InputError:
-            continue
-        colours.append([*target[mask].mean(axis=0), 1.0])
     if report is not None:
-        report("trace", len(masks), len(masks))
+        report("trace", 0, 1)
+    traced = trace_masks(masks, target, segments_per_path=segments, min_area=min_pixels)
+    if report is not None:
+        report("trace", 1, 1)
+    points, colours = traced.stacked_paths()
     return (
-        np.asarray(points, dtype=np.float64).reshape(len(points), 3 * segments, 2),
-        np.asarray(colours, dtype=np.float64).reshape(len(colours), 4),
+        points.reshape(len(traced.paths), 3 * segments, 2),
+        colours.reshape(len(traced.paths), 4),
     )
 
 

@@ -1,0 +1,124 @@
+"""End-to-end tests of the SAMVG pipeline with the real MobileSAM checkpoint and bench images."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import samvg
+from samvg import Config, InputError
+from samvg.io import read_image
+
+QUICK = {"points_per_side": 12, "iterations": 25, "use_lpips": False}
+
+
+@pytest.fixture(scope="module")
+def emoji(bench_dir):
+    image = Image.open(bench_dir / "emoji" / "twemoji_grinning_face.png").convert("RGB")
+    return np.asarray(image.resize((96, 96), Image.Resampling.LANCZOS))
+
+
+def flat_fill_mse(target):
+    return float(np.mean((target - target.mean(axis=(0, 1))) ** 2))
+
+
+@pytest.mark.slow
+def test_pipeline_stages_on_real_image(emoji, sam_checkpoint):
+    config = Config(checkpoint=str(sam_checkpoint), **QUICK)
+    stages = []
+    result = samvg.run(emoji, config, progress=lambda stage, done, total: stages.append(stage))
+    target = emoji.astype(np.float32) / 255.0
+    assert {"segment", "trace", "optimize", "missing"} <= set(stages)
+    assert result.counts["amg_masks"] >= result.counts["kept_masks"] >= 1
+    assert len(result.image.paths) == result.counts["paths"] >= 3
+    assert all(path.num_segments == 5 for path in result.image.paths)
+    rendered = result.image.render()
+    mse = float(np.mean((rendered - target) ** 2))
+    assert mse == pytest.approx(result.mse, rel=1e-3)
+    assert mse < flat_fill_mse(target) / 4
+    # optimization improves on the traced initialization
+    initial = float(np.mean((result.initial.render() - target) ** 2))
+    assert mse < initial
+    assert result.missing_map is not None and result.missing_map.shape == target.shape[:2]
+
+
+@pytest.mark.slow
+def test_same_input_and_seed_give_the_same_svg_bytes(emoji, sam_checkpoint):
+    config = Config(checkpoint=str(sam_checkpoint), **QUICK)
+    assert samvg.vectorize(emoji, config).to_svg() == samvg.vectorize(emoji, config).to_svg()
+
+
+@pytest.mark.slow
+def test_working_size_keeps_input_coordinates(emoji, sam_checkpoint):
+    big = np.asarray(Image.fromarray(emoji).resize((192, 192), Image.Resampling.NEAREST))
+    result = samvg.vectorize(big, Config(checkpoint=str(sam_checkpoint), size=96, **QUICK))
+    assert (result.width, result.height) == (192, 192)
+    points = np.concatenate([path.points for path in result.paths])
+    assert points.max() > 120  # scaled back from the 96-px working size
+    target = big.astype(np.float32) / 255.0
+    assert float(np.mean((result.render() - target) ** 2)) < flat_fill_mse(target) / 4
+
+
+@pytest.mark.slow
+def test_filter_by_impact_keeps_fewer_paths(bench_dir, sam_checkpoint):
+    photo = read_image(bench_dir / "photo" / "kodim23.png")
+    photo = np.asarray(Image.fromarray(photo).resize((128, 85), Image.Resampling.LANCZOS))
+    base = {**QUICK, "iterations": 0, "missing_components": False, "reprompt_uncovered": False}
+    with_filter = samvg.run(photo, Config(checkpoint=str(sam_checkpoint), **base))
+    without = samvg.run(
+        photo, Config(checkpoint=str(sam_checkpoint), filter_by_impact=False, **base)
+    )
+    assert with_filter.counts["amg_masks"] == without.counts["amg_masks"]
+    assert with_filter.counts["kept_masks"] < without.counts["kept_masks"]
+    assert without.counts["kept_masks"] == without.counts["amg_masks"]
+    assert with_filter.counts["paths"] < without.counts["paths"]
+
+
+def test_uniform_and_tiny_images_are_one_background_colour():
+    uniform = np.full((40, 60, 3), (10, 200, 30), np.uint8)
+    result = samvg.run(uniform, Config(checkpoint="/nonexistent/never/loaded.pt"))
+    assert result.image.paths == [] and result.notes[0].startswith("uniform image")
+    assert np.allclose(result.image.background, np.array((10, 200, 30)) / 255.0)
+    tiny = np.random.default_rng(0).integers(0, 255, (5, 7, 3), dtype=np.uint8)
+    result = samvg.run(tiny, Config(checkpoint="/nonexistent/never/loaded.pt"))
+    assert (result.image.width, result.image.height) == (7, 5)
+    assert result.notes[0].startswith("tiny image")
+
+
+def test_missing_lpips_weights_falls_back_to_mse(emoji, sam_checkpoint, tmp_path):
+    config = Config(
+        checkpoint=str(sam_checkpoint),
+        points_per_side=4,
+        iterations=2,
+        missing_components=False,
+        reprompt_uncovered=False,
+        lpips_weights=str(tmp_path / "missing_lpips.pt"),
+    )
+    result = samvg.run(emoji, config)
+    assert any(note.startswith("LPIPS off") for note in result.notes)
+    assert result.counts["paths"] >= 1
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"model": "vit_q"}, "unknown SAM model"),
+        ({"iterations": -1}, "iterations must be an integer >= 0"),
+        ({"size": 4}, "size must be an integer >= 8"),
+        ({"max_paths": 0}, "max paths must be a positive integer"),
+        ({"impact_threshold": float("nan")}, "impact threshold must be a finite number"),
+        ({"uncovered_radius": 0.0}, "uncovered radius must be in (0, 0.5]"),
+    ],
+)
+def test_bad_config_is_a_clear_error(settings, message):
+    with pytest.raises(InputError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        Config(**settings)
+
+
+def test_bad_images_are_clear_errors(tmp_path):
+    with pytest.raises(InputError, match="not found"):
+        samvg.run(tmp_path / "nothing.png")
+    (tmp_path / "text.png").write_text("not an image")
+    with pytest.raises(InputError, match="cannot read image"):
+        samvg.run(tmp_path / "text.png")
+    with pytest.raises(InputError, match="NaN"):
+        samvg.run(np.full((20, 20, 3), np.nan, np.float32))
