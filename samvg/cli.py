@@ -84,6 +84,7 @@ def _config(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
         "iterations": arguments.iterations,
         "size": arguments.size,
         "crop_n_layers": arguments.crops,
+        "threads": arguments.threads,
         "lpips_weights": arguments.lpips_weights,
     }
     settings.update({key: value for key, value in optional.items() if value is not None})
@@ -314,6 +315,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     vectorize.add_argument("--seed", type=int, default=0)
     vectorize.add_argument("--device", default="cpu")
+    vectorize.add_argument("--threads", type=int,
+                           help="torch threads for SAM (default: torch's; 1 on a busy machine)")
     vectorize.add_argument(
         "--model",
         default="mobile_sam",

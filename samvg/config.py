@@ -49,7 +49,7 @@ class Config:
     xing_weight: float = 0.01
     use_lpips: bool = True
     lpips_weight: float = 0.05
-    lpips_size: int = 224
+    lpips_size: int = 128
     """LPIPS is computed on the render resized to this longest side (cost, not quality)."""
     lpips_weights: str | None = None
 
@@ -58,12 +58,18 @@ class Config:
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015
+    missing_impact_threshold: float = 2e-5
+    """Stage 4 filters by impact against the optimized render, where any gain is on top of a good
+    fit: small parts (eyes) gain little as flat colour, so the bar is lower than in stage 1."""
 
     # product
     size: int = 512
     """Working resolution (longest side); the SVG keeps the input's pixel coordinates."""
     seed: int = 0
     device: str = "cpu"
+    threads: int | None = None
+    """torch threads for SAM (None = torch's default). Fitting always runs on one thread: its
+    tensors are small, and a thread pool stalls whenever another process holds a core."""
 
     def __post_init__(self) -> None:
         if self.model not in SAM_MODELS:
@@ -90,6 +96,7 @@ class Config:
             raise InputError(f"max paths must be a positive integer, got {self.max_paths!r}")
         non_negative = (
             "impact_threshold",
+            "missing_impact_threshold",
             "min_area",
             "point_learning_rate",
             "colour_learning_rate",
@@ -109,6 +116,10 @@ class Config:
             raise InputError(
                 f"min area must be below 1 (a fraction of the image), got {self.min_area}"
             )
+        if self.threads is not None and (
+            isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1
+        ):
+            raise InputError(f"threads must be a positive integer, got {self.threads!r}")
         if not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0:
             raise InputError(f"seed must be a non-negative integer, got {self.seed!r}")
         if self.device != "cpu" and not self.device.startswith(("cuda", "mps")):

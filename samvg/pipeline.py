@@ -123,6 +123,23 @@ def run(
     import torch
 
     config = config or Config()
+    threads = torch.get_num_threads()
+    if config.threads is not None:
+        torch.set_num_threads(config.threads)
+    try:
+        return _run(image, config, progress, log)
+    finally:
+        torch.set_num_threads(threads)
+
+
+def _run(
+    image: Any,
+    config: Config,
+    progress: ProgressCallback | None,
+    log: Callable[[str], None] | None,
+) -> PipelineResult:
+    import torch
+
     report = progress or (lambda _stage, _done, _total: None)
     say = log or (lambda _text: None)
     started = time.perf_counter()

@@ -102,7 +102,7 @@ def missing_masks(
 ) -> list[np.ndarray]:
     """Stage 4's masks: SAM at the missing-component prompts, filtered by impact with the render
     I′ as the starting canvas; returned largest first (they are painted on top of the SVG)."""
-    canvas = ImpactCanvas(target, config.impact_threshold, start=render)
+    canvas = ImpactCanvas(target, config.missing_impact_threshold, start=render)
     _offer_best(canvas, segmenter.prompt(prompts), config, below=False)
     return sorted(canvas.kept_masks, key=lambda m: -int(m.sum()))
 
