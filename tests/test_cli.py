@@ -91,9 +91,17 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
             "--iterations",
             "60",
             "--no-lpips",
+            "--save-stages",
+            str(tmp_path / "stages"),
         ]
     )
     assert code == 0
+    stages = sorted(p.name for p in (tmp_path / "stages").iterdir())
+    assert {"1_masks.png", "2_initial.svg", "3_optimized.svg", "5_final.svg"} <= set(stages)
+    assert "comparison.png" in stages
+    assert VectorImage.load(tmp_path / "stages" / "5_final.svg").to_svg() == VectorImage.load(
+        output
+    ).to_svg()
     result = VectorImage.load(output)
     target = read_image(SAMPLE).astype(np.float32) / 255.0
     assert (result.width, result.height) == (512, 280)
@@ -117,3 +125,33 @@ def test_bad_settings_are_clear_errors(tmp_path, capsys, option, message):
     assert main(["vectorize", str(SAMPLE), "-o", str(tmp_path / "o.svg"), *option]) == 1
     assert message in capsys.readouterr().err
     assert not (tmp_path / "o.svg").exists()
+
+
+def test_batch_skips_done_images_and_survives_failures(tmp_path, capsys):
+    from PIL import Image
+
+    inputs, outputs = tmp_path / "in", tmp_path / "out"
+    inputs.mkdir()
+    outputs.mkdir()
+    Image.new("RGB", (30, 20), (250, 10, 10)).save(inputs / "red.png")
+    Image.new("L", (30, 20), 90).save(inputs / "grey.png")  # grayscale input
+    Image.new("RGB", (30, 20), (0, 0, 255)).save(inputs / "done.png")
+    (outputs / "done.svg").write_text("<svg/>")
+    (inputs / "broken.jpg").write_bytes(b"\xff\xd8 not a jpeg")
+    (inputs / "notes.txt").write_text("ignored: not an image")
+    code = main([str(inputs), "-o", str(outputs), "--quiet"])
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "2 vectorized, 1 skipped (already done), 1 failed" in err
+    assert "broken.jpg" in err and "Traceback" not in err
+    assert (outputs / "done.svg").read_text() == "<svg/>"
+    assert sorted(p.name for p in outputs.iterdir()) == ["done.svg", "grey.svg", "red.svg"]
+    grey = VectorImage.load(outputs / "grey.svg")
+    assert grey.paths == [] and np.allclose(grey.background, (90 / 255,) * 3, atol=1 / 255)
+    # a glob selects the same images; everything is done now, so nothing fails
+    assert main([str(inputs / "*.png"), "-o", str(outputs), "--quiet"]) == 0
+
+
+def test_batch_needs_an_output_folder(tmp_path, capsys):
+    assert main([str(SAMPLE), str(SAMPLE), "-o", str(tmp_path / "x.svg")]) == 1
+    assert "-o must be a folder" in capsys.readouterr().err
