@@ -77,7 +77,7 @@ def test_uniform_and_tiny_images_are_one_background_colour():
     uniform = np.full((40, 60, 3), (10, 200, 30), np.uint8)
     result = samvg.run(uniform, Config(checkpoint="/nonexistent/never/loaded.pt"))
     assert result.image.paths == [] and result.notes[0].startswith("uniform image")
-    assert np.allclose(result.image.background, np.array((10, 200, 30)) / 255.0)
+    assert np.allclose(result.image.background, np.array((10, 200, 30)) / 255.0, atol=1e-6)
     tiny = np.random.default_rng(0).integers(0, 255, (5, 7, 3), dtype=np.uint8)
     result = samvg.run(tiny, Config(checkpoint="/nonexistent/never/loaded.pt"))
     assert (result.image.width, result.image.height) == (7, 5)
