@@ -150,7 +150,7 @@ def _run(
     result = PipelineResult(image=VectorImage(original.shape[1], original.shape[0]), scale=scale)
     result.target = target
 
-    mean_colour = tuple(float(v) for v in target.reshape(-1, 3).mean(axis=0))
+    mean_colour = tuple(float(v) for v in target.reshape(-1, 3).mean(axis=0, dtype=np.float64))
     if (
         min(height, width) < MIN_WORKING_SIDE
         or np.ptp(target, axis=(0, 1)).max() <= UNIFORM_TOLERANCE
