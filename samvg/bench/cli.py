@@ -79,7 +79,7 @@ class _RichProgress:
             console=console,
         )
         self.overall = self.progress.add_task("results", total=None)
-        self.current = self.progress.add_task("", total=None, visible=False)
+        self.current: Any = None
         self.label = ""
 
     def start(self, total: int) -> None:
@@ -87,7 +87,9 @@ class _RichProgress:
 
     def begin(self, image_id: str, method: str) -> None:
         self.label = f"{image_id} · {method}"
-        self.progress.reset(self.current, total=None, description=self.label, visible=True)
+        if self.current is not None:
+            self.progress.remove_task(self.current)  # a fresh bar: no total until told one
+        self.current = self.progress.add_task(self.label, total=None)
 
     def stage(self, stage: str, done: int, total: int) -> None:
         self.progress.update(

@@ -153,10 +153,11 @@ def plan_methods(names: Sequence[str], table: dict[str, Method] | None = None) -
 
 
 def _settings(config: Config) -> dict[str, Any]:
+    """The config as run.json keeps it (JSON values, so a reloaded copy compares equal)."""
     settings = dataclasses.asdict(config)
     for name in _FREE_SETTINGS:
         settings.pop(name, None)
-    return settings
+    return json.loads(json.dumps(settings, default=str))
 
 
 def _check_settings(layout: Layout, settings: dict[str, Any]) -> None:
