@@ -57,13 +57,13 @@ def main() -> None:
     table: list[dict[str, object]] = []
     for row in rows:
         original = read_image(BENCH / row["png"])
-        target_u8, _ = working_image(original, 512)
+        target_u8, target_scale = working_image(original, 512)
         target = target_u8.astype(np.float32) / 255.0
         counts: dict[str, int] = {}
         for preset in presets:
             config = PRESETS[preset]
             result = samvg.run(original, config)
-            render = result.image.render(scale=result.scale)
+            render = result.image.render(scale=target_scale)[: target.shape[0], : target.shape[1]]
             counts[preset] = len(result.image.paths)
             table.append(
                 {

@@ -165,6 +165,7 @@ def _run(
     torch.manual_seed(config.seed)
     from samvg.segment import (
         Segmenter,
+        min_component_pixels,
         missing_component_map,
         missing_component_prompts,
         missing_masks,
@@ -180,6 +181,7 @@ def _run(
     result.timings["segment"] = time.perf_counter() - clock
     result.counts.update(
         amg_masks=selection.amg_masks,
+        amg_components=selection.amg_components,
         kept_masks=selection.kept_after_filter,
         reprompt_masks=selection.reprompt_masks,
     )
@@ -187,7 +189,7 @@ def _run(
 
     # Stage 2
     clock = time.perf_counter()
-    min_pixels = max(4.0, config.min_area * height * width)
+    min_pixels = min_component_pixels(config, height, width)
     points, colours = _trace(selection.masks, target, config.segments, min_pixels, report)
     covered = np.zeros((height, width), dtype=bool)
     for mask in selection.masks:

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from samvg.config import Config
+from samvg.segment.components import all_components, split_components
 from samvg.segment.impact import ImpactCanvas, filter_by_impact, keep_all
 from samvg.segment.prompts import uncovered_prompts
 
@@ -63,6 +64,12 @@ class MaskSelection:
     reprompt_masks: int = 0
     error: float = 1.0
     impacts: list[float] = field(default_factory=list)
+    amg_components: int = 0
+
+
+def min_component_pixels(config: Config, height: int, width: int) -> float:
+    """Components smaller than this many pixels never become paths."""
+    return max(4.0, config.min_area * height * width)
 
 
 def select_masks(image: np.ndarray, segmenter: Segmenter, config: Config) -> MaskSelection:
@@ -70,18 +77,22 @@ def select_masks(image: np.ndarray, segmenter: Segmenter, config: Config) -> Mas
     the new masks (painted beneath smaller kept masks, as they will be in area order)."""
     target = image.astype(np.float32) / 255.0
     height, width = image.shape[:2]
+    min_pixels = min_component_pixels(config, height, width)
     amg = segmenter.automatic(image)
+    candidates = all_components(amg, min_pixels)
     if config.filter_by_impact:
-        kept, canvas = filter_by_impact(amg, target, config.impact_threshold)
+        kept, canvas = filter_by_impact(candidates, target, config.impact_threshold)
     else:
-        kept, canvas = keep_all(amg, target)
+        kept, canvas = keep_all(candidates, target)
     selection = MaskSelection([], canvas.canvas, amg_masks=len(amg), kept_after_filter=len(kept))
+    selection.amg_components = len(candidates)
     if config.reprompt_uncovered:
         radius = config.uncovered_radius * max(height, width)
         prompts = uncovered_prompts(canvas.covered, radius, seed=config.seed)
         selection.reprompts = prompts
-        candidates = segmenter.prompt(prompts)
-        selection.reprompt_masks = _offer_best(canvas, candidates, config, below=True)
+        selection.reprompt_masks = _offer_best(
+            canvas, segmenter.prompt(prompts), config, min_pixels, below=True
+        )
     pairs = list(zip(canvas.kept_masks, canvas.impacts, strict=True))
     if config.max_paths is not None and len(pairs) > config.max_paths:
         pairs = sorted(pairs, key=lambda pair: -pair[1])[: config.max_paths]
@@ -103,16 +114,21 @@ def missing_masks(
     """Stage 4's masks: SAM at the missing-component prompts, filtered by impact with the render
     I′ as the starting canvas; returned largest first (they are painted on top of the SVG)."""
     canvas = ImpactCanvas(target, config.missing_impact_threshold, start=render)
-    _offer_best(canvas, segmenter.prompt(prompts), config, below=False)
+    min_pixels = min_component_pixels(config, *target.shape[:2])
+    _offer_best(canvas, segmenter.prompt(prompts), config, min_pixels, below=False)
     return sorted(canvas.kept_masks, key=lambda m: -int(m.sum()))
 
 
 def _offer_best(
-    canvas: ImpactCanvas, candidates: list[list[np.ndarray]], config: Config, below: bool
+    canvas: ImpactCanvas,
+    candidates: list[list[np.ndarray]],
+    config: Config,
+    min_pixels: float,
+    below: bool,
 ) -> int:
-    """Per prompt, offer the candidate mask with the largest impact (with the filter off: SAM's
-    first, most confident-by-order candidate). Prompts are taken in the order given (largest
-    region first). Returns how many masks were kept."""
+    """Per prompt, take the candidate mask with the largest impact (with the filter off: SAM's
+    first candidate) and offer its components. Prompts are taken in the order given (largest
+    region first). Returns how many components were kept."""
     kept = 0
     for options in candidates:
         if not options:
@@ -120,7 +136,9 @@ def _offer_best(
         if config.filter_by_impact:
             impacts = [canvas.impact_of(mask, below)[0] for mask in options]
             best = options[int(np.argmax(impacts))]
-            kept += canvas.offer(best, below=below).kept
         else:
-            kept += canvas.offer(options[0], below=below, keep=True).kept
+            best = options[0]
+        for part in split_components(best, min_pixels):
+            forced = None if config.filter_by_impact else True
+            kept += canvas.offer(part, below=below, keep=forced).kept
     return kept
