@@ -47,6 +47,9 @@ ROWS = (
 )
 #: Images shown on the contact sheet (the first common image of each category, in turn).
 CONTACT_IMAGES = 6
+#: Categories left off the contact sheet: the sheet is committed with the results, and copies of
+#: the bench's photos and paintings (or renders traced from them) do not go into the repository.
+CONTACT_SKIP_CATEGORIES = ("photo", "painting")
 
 NOTES = """\
 - Means over the images on which every method succeeded ("images" row); failures are listed
@@ -192,7 +195,8 @@ def _contact_sheet(
     chosen: list[str] = []
     by_category: dict[str, list[str]] = {}
     for image in ids:
-        by_category.setdefault(category[image], []).append(image)
+        if category[image] not in CONTACT_SKIP_CATEGORIES:
+            by_category.setdefault(category[image], []).append(image)
     while len(chosen) < CONTACT_IMAGES and any(by_category.values()):
         for queue in by_category.values():
             if queue and len(chosen) < CONTACT_IMAGES:
