@@ -33,3 +33,8 @@ def bench_dir() -> Path:
 @pytest.fixture(scope="session")
 def lpips_weights() -> Path:
     return shared_file("SAMVG_LPIPS_WEIGHTS", "models/lpips_alex.pt")
+
+
+@pytest.fixture(scope="session")
+def fid_weights() -> Path:
+    return shared_file("SAMVG_FID_WEIGHTS", "models/fid_inception_v3.torchscript.pt")

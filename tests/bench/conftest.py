@@ -1,29 +1,20 @@
 """Fixtures of the benchmark tests: a tiny manifest of real images and the metric weights."""
 
 import csv
-import os
 from pathlib import Path
 
 import pytest
 
-SHARED = Path(__file__).resolve().parents[2].parent / "shared"
-
-
-def _shared_file(variable: str, relative: str) -> Path:
-    candidate = Path(os.environ.get(variable) or SHARED / relative)
-    if not candidate.is_file():
-        pytest.skip(f"{relative} not found (set {variable} or place ../shared beside the repo)")
-    return candidate
 
 
 @pytest.fixture(scope="session")
-def lpips_file() -> Path:
-    return _shared_file("SAMVG_LPIPS_WEIGHTS", "models/lpips_alex.pt")
+def lpips_file(lpips_weights: Path) -> Path:
+    return lpips_weights
 
 
 @pytest.fixture(scope="session")
-def fid_file() -> Path:
-    return _shared_file("SAMVG_FID_WEIGHTS", "models/fid_inception_v3.torchscript.pt")
+def fid_file(fid_weights: Path) -> Path:
+    return fid_weights
 
 
 @pytest.fixture

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import http.server
-import os
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -11,14 +10,6 @@ from pathlib import Path
 import pytest
 
 SHARED = Path(__file__).resolve().parents[3] / "shared"
-
-
-def _shared(variable: str, relative: str) -> Path:
-    """Like tests/conftest.py's ``shared_file``: env variable, else ../shared; skip if absent."""
-    candidate = Path(os.environ.get(variable) or SHARED / relative)
-    if not candidate.is_file():
-        pytest.skip(f"{relative} not found (set {variable} or place ../shared beside the repo)")
-    return candidate
 
 
 class _Files(http.server.BaseHTTPRequestHandler):
@@ -68,11 +59,6 @@ def cache(tmp_path, monkeypatch) -> Path:
     monkeypatch.delenv("SAMVG_LPIPS_WEIGHTS", raising=False)
     monkeypatch.delenv("SAMVG_FID_WEIGHTS", raising=False)
     return folder
-
-
-@pytest.fixture(scope="session")
-def fid_weights() -> Path:
-    return _shared("SAMVG_FID_WEIGHTS", "models/fid_inception_v3.torchscript.pt")
 
 
 @pytest.fixture(scope="session")
