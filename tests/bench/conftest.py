@@ -6,7 +6,6 @@ from pathlib import Path
 import pytest
 
 
-
 @pytest.fixture(scope="session")
 def lpips_file(lpips_weights: Path) -> Path:
     return lpips_weights
