@@ -118,8 +118,8 @@ def _expand_inputs(inputs: list[str]) -> tuple[list[Path], bool]:
 
 def _vectorize(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-untyped-def]
     config = _config(arguments)
-    inputs, batch = _expand_inputs(arguments.input)
-    if not batch:
+    inputs = arguments.inputs
+    if not arguments.batch_mode:
         _check_output(arguments.output, (".svg",))
         if arguments.preview is not None:
             _check_output(arguments.preview, (".png",))
@@ -237,9 +237,10 @@ def mask_overlay(image, masks, seed: int = 0):  # type: ignore[no-untyped-def]
     import numpy as np
 
     rng = np.random.default_rng(seed)
-    overlay = np.asarray(image, dtype=np.float32).copy()
-    if overlay.dtype != np.float32 or overlay.max() > 1.0:
-        overlay = overlay / 255.0
+    pixels = np.asarray(image)
+    overlay = pixels.astype(np.float32)
+    if pixels.dtype == np.uint8:
+        overlay /= 255.0
     for mask in masks:
         overlay[mask] = 0.45 * overlay[mask] + 0.55 * rng.uniform(0, 1, 3)
     return overlay
@@ -362,11 +363,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args and args[0] not in SUBCOMMANDS and args[0] not in ("-h", "--help"):
         args.insert(0, "vectorize")
     arguments = build_parser().parse_args(args)
-    arguments.batch_mode = False
     console = Console(stderr=True)
     try:
         if arguments.command == "vectorize":
-            arguments.batch_mode = _expand_inputs(arguments.input)[1]
+            arguments.inputs, arguments.batch_mode = _expand_inputs(arguments.input)
         return int(arguments.handler(arguments, console) or 0)
     except SamvgError as error:
         console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, soft_wrap=True)

@@ -163,6 +163,7 @@ def _run(
         return result
 
     torch.manual_seed(config.seed)
+    from samvg.render import render_array
     from samvg.segment import (
         Segmenter,
         min_component_pixels,
@@ -220,7 +221,7 @@ def _run(
     if config.missing_components:
         clock = time.perf_counter()
         report("missing", 0, 1)
-        render = _render(points, colours, width, height, background)
+        render = render_array(points, colours, width, height, background)
         radius = config.missing_radius * max(height, width)
         averaged, above = missing_component_map(target, render, radius, config.missing_threshold)
         prompts = missing_component_prompts(averaged, above)
@@ -241,7 +242,8 @@ def _run(
             result.timings["refine"] = time.perf_counter() - clock
 
     result.image = _to_image(points, colours, background, original.shape, scale)
-    result.mse = float(np.mean((_render(points, colours, width, height, background) - target) ** 2))
+    final_render = render_array(points, colours, width, height, background)
+    result.mse = float(np.mean((final_render - target) ** 2))
     result.counts["paths"] = len(result.image.paths)
     result.timings["total"] = time.perf_counter() - started
     return result
@@ -295,22 +297,6 @@ def _fit(points, colours, target, background, options, stage, report):  # type: 
     if not (np.all(np.isfinite(fit.points)) and np.all(np.isfinite(fit.colours))):
         raise SamvgError("optimization diverged (non-finite coordinates); try fewer iterations")
     return fit
-
-
-def _render(points, colours, width, height, background) -> np.ndarray:  # type: ignore[no-untyped-def]
-    import torch
-
-    from samvg.render import rasterize
-
-    with torch.no_grad():
-        image = rasterize(
-            torch.from_numpy(points).float(),
-            torch.from_numpy(colours).float(),
-            width,
-            height,
-            background=background,
-        )
-    return image.numpy()
 
 
 def _to_image(points, colours, background, shape, scale) -> VectorImage:  # type: ignore[no-untyped-def]

@@ -100,9 +100,7 @@ class VectorImage:
 
     def render(self, scale: float = 1.0) -> np.ndarray:
         """Rasterize to a float32 (H, W, 3) array in [0, 1]; no background means white."""
-        import torch
-
-        from samvg.render import rasterize
+        from samvg.render import render_array
 
         if not (math.isfinite(scale) and scale > 0):
             raise InputError(f"render scale must be a positive number, got {scale}")
@@ -110,14 +108,7 @@ class VectorImage:
         height = max(1, round(self.height * scale))
         background = self.background if self.background is not None else (1.0, 1.0, 1.0)
         points, colours = self.stacked_paths()
-        image = rasterize(
-            torch.from_numpy(points * scale).float(),
-            torch.from_numpy(colours).float(),
-            width,
-            height,
-            background=background,
-        )
-        return image.detach().cpu().numpy().astype(np.float32)
+        return render_array(points * scale, colours, width, height, background=background)
 
     def stacked_paths(self) -> tuple[np.ndarray, np.ndarray]:
         """All paths as arrays (P, 3K, 2) and RGBA (P, 4) for the rasterizer.

@@ -129,10 +129,9 @@ def live(
     The step budget is split evenly over the stages of :func:`schedule` (the remainder goes to
     the last). ``seed`` is accepted for a uniform signature; the method is deterministic.
     """
-    import torch
 
     from samvg.optimize import fit_paths
-    from samvg.render import rasterize
+    from samvg.render import render_array
 
     del seed
     check_counts(path_count, segments)
@@ -148,14 +147,8 @@ def live(
     colours = np.zeros((0, 4))
     done = 0
     for added, stage_steps in zip(stages, per_stage, strict=True):
-        render = rasterize(
-            torch.from_numpy(points).float(),
-            torch.from_numpy(colours).float(),
-            width,
-            height,
-            background=background,
-        )
-        seeds = find_seeds(error_map(render.detach().numpy(), image), image, added)
+        render = render_array(points, colours, width, height, background=background)
+        seeds = find_seeds(error_map(render, image), image, added)
         points = np.concatenate([points, [blob(s.centre, s.radius, segments) for s in seeds]])
         colours = np.concatenate([colours, [[*s.colour, 1.0] for s in seeds]])
 

@@ -211,6 +211,26 @@ def rasterize(
         raise InputError(f"canvas {width}x{height} is too large to allocate") from exc
 
 
+def render_array(
+    points: np.ndarray,
+    colors: np.ndarray,
+    width: int,
+    height: int,
+    background: Sequence[float] | None = (1.0, 1.0, 1.0),
+) -> np.ndarray:
+    """`rasterize` for numpy scenes, without gradients: points (P, 3K, 2) and RGBA (P, 4) to a
+    float32 (height, width, 3) array."""
+    with torch.no_grad():
+        image = rasterize(
+            torch.from_numpy(np.asarray(points)).float(),
+            torch.from_numpy(np.asarray(colors)).float(),
+            width,
+            height,
+            background=background,
+        )
+    return image.numpy().astype(np.float32, copy=False)
+
+
 def warmup() -> None:
     """Compile (or load from the on-disk cache) every kernel, forward and backward."""
     pts = torch.tensor(

@@ -51,6 +51,7 @@ class ImpactCanvas:
     covered: np.ndarray = field(init=False)
     error: np.ndarray = field(init=False)
     kept_masks: list[np.ndarray] = field(init=False, default_factory=list)
+    kept_areas: list[int] = field(init=False, default_factory=list)
     kept_colours: list[np.ndarray] = field(init=False, default_factory=list)
     impacts: list[float] = field(init=False, default_factory=list)
 
@@ -98,6 +99,7 @@ class ImpactCanvas:
             self.error[rows, cols] = new_error
             self.covered[rows, cols] = True
             self.kept_masks.append(np.asarray(mask, dtype=bool))
+            self.kept_areas.append(int(np.count_nonzero(mask)))
             self.kept_colours.append(colour)
             self.impacts.append(impact)
         return ImpactDecision(accept, impact, colour)
@@ -112,8 +114,8 @@ class ImpactCanvas:
         colour = self.target[mask].mean(axis=0)
         visible = mask
         if below:
-            for other in self.kept_masks:
-                if np.count_nonzero(other) < area:
+            for other, other_area in zip(self.kept_masks, self.kept_areas, strict=True):
+                if other_area < area:
                     visible = visible & ~other
         rows, cols = np.nonzero(visible)
         new_error = np.mean((self.target[rows, cols] - colour) ** 2, axis=1)
