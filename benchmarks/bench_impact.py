@@ -20,16 +20,11 @@ from pathlib import Path
 import numpy as np
 
 import samvg
+from samvg.imaging import filled_components, resize_longest, to_float_rgb
 from samvg.io import read_image
-from samvg.pipeline import working_image
-from samvg.segment import (
-    Segmenter,
-    all_components,
-    filter_by_impact,
-    keep_all,
-    min_component_pixels,
-)
+from samvg.segment import Segmenter, filter_by_impact, keep_all
 from samvg.trace import trace_masks
+from samvg.trace.stage import uncovered_background
 
 REPO = Path(__file__).resolve().parents[1]
 BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
@@ -48,31 +43,31 @@ def main() -> None:
         if len(chosen[row["category"]]) < arguments.per_category:
             chosen[row["category"]].append(row)
     config = samvg.Config()
-    segmenter = Segmenter(config)
+    segmenter = Segmenter(config.segment)
     results: dict[str, list[tuple[int, float, float]]] = defaultdict(list)
     for category in sorted(chosen):
         for row in chosen[category]:
-            image, _ = working_image(read_image(BENCH / row["png"]), config.size)
-            target = image.astype(np.float32) / 255.0
+            image, _ = resize_longest(read_image(BENCH / row["png"]), config.size)
+            target = to_float_rgb(image)
             height, width = target.shape[:2]
-            min_pixels = min_component_pixels(config, height, width)
-            candidates = all_components(segmenter.automatic(image), min_pixels)
+            min_pixels = config.segment.min_pixels(width, height)
+            candidates = [
+                part
+                for mask in segmenter.automatic(image)
+                for part in filled_components(mask, min_pixels)
+            ]
             for threshold in THRESHOLDS:
                 if threshold is None:
                     kept, canvas = keep_all(candidates, target)
                 else:
                     kept, canvas = filter_by_impact(candidates, target, threshold)
                 masks = sorted((candidates[i] for i in kept), key=lambda m: -int(m.sum()))
-                traced = trace_masks(masks, target, config.segments, min_pixels)
-                covered = np.logical_or.reduce(masks) if masks else np.zeros((height, width), bool)
-                traced.background = (
-                    tuple(float(v) for v in target[~covered].mean(axis=0))
-                    if (~covered).any()
-                    else (1.0, 1.0, 1.0)
-                )
+                traced = trace_masks(masks, target, config.trace.segments, min_pixels)
+                traced = traced.with_background(uncovered_background(masks, target))
                 mse = float(np.mean((traced.render() - target) ** 2))
-                results[str(threshold)].append((len(traced.paths), canvas.mean_error, mse))
-                print(row["id"], threshold, len(traced.paths), canvas.mean_error, mse, flush=True)
+                paths = traced.path_count
+                results[str(threshold)].append((paths, canvas.mean_error, mse))
+                print(row["id"], threshold, paths, canvas.mean_error, mse, flush=True)
     count = sum(len(v) for v in chosen.values())
     lines = [
         "# Filter by impact: threshold against paths and error",

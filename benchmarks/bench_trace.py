@@ -1,9 +1,9 @@
 """Benchmark of samvg.trace: accuracy (IoU of the rendered paths vs the mask) and speed.
 
-1. Synthetic shapes on a 128x128 canvas (samvg.trace.synthetic) x segments per path (3, 4, 5, 6,
-   8): IoU of the traced path rendered by the project's rasterizer (coverage > 0.5) against the
-   mask, the fitting error (max distance contour -> curve) and the median time of one
-   ``trace_components`` call.
+1. Synthetic shapes on a 128x128 canvas (tests/trace/synthetic.py) x segments per path
+   (3, 4, 5, 6, 8): IoU of the traced path rendered by the project's rasterizer (coverage >
+   0.5) against the mask, the fitting error (max distance contour -> curve) and the median
+   time of one ``trace_components`` call.
 2. Real SAM masks: MobileSAM automatic masks (``--points`` per side) of bench photos at
    ``--side`` px, traced with ``trace_masks_with_info`` at 4 and 5 segments; mean, median and
    worst IoU per mask against the mask as the tracer models it (components of at least
@@ -19,6 +19,7 @@ import argparse
 import os
 import platform
 import statistics
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -28,9 +29,19 @@ from PIL import Image
 from scipy import ndimage
 
 from samvg.trace import DEFAULT_MIN_AREA, trace_components, trace_masks, trace_masks_with_info
-from samvg.trace.synthetic import SHAPES, iou, random_blobs, render_coverage, rounded_rectangle
 
 REPO = Path(__file__).resolve().parents[1]
+# The synthetic masks live with the tests (tests/trace/synthetic.py), not in the package: put
+# the repository root first on the path so `tests` imports when this script is run directly.
+sys.path.insert(0, str(REPO))
+from tests.trace.synthetic import (  # noqa: E402
+    SHAPES,
+    iou,
+    random_blobs,
+    render_coverage,
+    rounded_rectangle,
+)
+
 SHARED = REPO.parent / "shared"
 SEGMENTS = (3, 4, 5, 6, 8)
 PHOTOS = ("kodim04", "kodim05", "kodim23")

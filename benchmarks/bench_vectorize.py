@@ -24,9 +24,10 @@ import torch
 
 import samvg
 from samvg.baselines import path_count, run_baseline
+from samvg.imaging import resize_longest, to_float_rgb
 from samvg.io import read_image
 from samvg.metrics import load_lpips, lpips_distance
-from samvg.pipeline import fit_options, working_image
+from samvg.optimize import FitSettings
 
 REPO = Path(__file__).resolve().parents[1]
 BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
@@ -57,14 +58,14 @@ def main() -> None:
     table: list[dict[str, object]] = []
     for row in rows:
         original = read_image(BENCH / row["png"])
-        target_u8, target_scale = working_image(original, 512)
-        target = target_u8.astype(np.float32) / 255.0
+        target_u8, target_scale = resize_longest(original, 512)
+        target = to_float_rgb(target_u8)
         counts: dict[str, int] = {}
         for preset in presets:
             config = PRESETS[preset]
             result = samvg.run(original, config)
             render = result.image.render(scale=target_scale)[: target.shape[0], : target.shape[1]]
-            counts[preset] = len(result.image.paths)
+            counts[preset] = path_count(result.image)
             table.append(
                 {
                     "image": row["id"],
@@ -78,7 +79,7 @@ def main() -> None:
             )
             print(table[-1], flush=True)
         reference = counts.get("default", next(iter(counts.values())))
-        options = fit_options(PRESETS["default"], target)
+        options = FitSettings.from_options(PRESETS["default"].fit, target)
         for baseline in baselines:
             started = time.perf_counter()
             output = run_baseline(baseline, target, reference, options, seed=0)

@@ -255,7 +255,7 @@ def _segment(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-
     image = read_image(arguments.input)
     config = Config(checkpoint=arguments.checkpoint, model=arguments.model)
     with console.status("segmenting"):
-        masks = Segmenter(config).automatic(image)
+        masks = Segmenter(config.segment, config.device).automatic(image)
     masks.sort(key=lambda m: -int(m.sum()))
     write_png(arguments.output, mask_overlay(image, masks))
     _say(console, f"wrote {arguments.output} ({len(masks)} masks)")

@@ -1,9 +1,12 @@
-"""`Config`: every setting of the vectorization pipeline, checked once, with the paper's defaults.
+"""`Config`: every setting of the vectorization pipeline, grouped by stage and checked once.
 
 Where the paper gives a value it is the default (32x32 AMG grid, 5 cubic segments per path, i.e.
 34 numbers per path with RGBA; Adam with learning rates 1 for points and 0.01 for colours; the
 missing-component threshold 0.784). Where it does not (impact threshold, kernel radii, loss
 weights) the value was chosen on ``../shared/bench`` with ``benchmarks/bench_vectorize.py``.
+
+Settings here are in the user's terms (fractions of the image, counts); each stage turns its
+group into typed settings in working pixels once, when the canvas size is known.
 """
 
 from __future__ import annotations
@@ -17,11 +20,36 @@ from samvg.errors import InputError
 SAM_MODELS = ("mobile_sam", "vit_b", "vit_l", "vit_h")
 
 
-@dataclass(frozen=True)
-class Config:
-    """Settings of :func:`samvg.vectorize`. ``Config.fast()`` is the quick preset."""
+def _label(name: str) -> str:
+    return name.replace("_", " ")
 
-    # segmentation (stage 1)
+
+def _check_integer(owner: object, name: str, smallest: int) -> None:
+    value = getattr(owner, name)
+    if isinstance(value, bool) or not isinstance(value, int) or value < smallest:
+        raise InputError(f"{_label(name)} must be an integer >= {smallest}, got {value!r}")
+
+
+def _check_non_negative(owner: object, name: str) -> None:
+    value = getattr(owner, name)
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not 0.0 <= float(value) < float("inf")
+    ):
+        raise InputError(f"{_label(name)} must be a finite number >= 0, got {value!r}")
+
+
+def _check_radius(owner: object, name: str) -> None:
+    value = getattr(owner, name)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 < value <= 0.5:
+        raise InputError(f"{_label(name)} must be in (0, 0.5], got {value!r}")
+
+
+@dataclass(frozen=True)
+class SegmentOptions:
+    """Stage 1: SAM's automatic masks, filter by impact, re-prompts in uncovered regions."""
+
     model: str = "mobile_sam"
     checkpoint: str | None = None
     points_per_side: int = 32
@@ -38,12 +66,49 @@ class Config:
     max_paths: int | None = None
     """Keep at most this many paths (the masks with the largest impact); None = no limit."""
 
-    # tracing (stage 2)
-    segments: int = 5
+    def __post_init__(self) -> None:
+        if self.model not in SAM_MODELS:
+            raise InputError(
+                f"unknown SAM model {self.model!r}; choose one of {', '.join(SAM_MODELS)}"
+            )
+        _check_integer(self, "points_per_side", 1)
+        _check_integer(self, "crop_n_layers", 0)
+        if self.max_paths is not None and (
+            isinstance(self.max_paths, bool)
+            or not isinstance(self.max_paths, int)
+            or self.max_paths < 1
+        ):
+            raise InputError(f"max paths must be a positive integer, got {self.max_paths!r}")
+        _check_non_negative(self, "impact_threshold")
+        _check_non_negative(self, "min_area")
+        _check_radius(self, "uncovered_radius")
+        if self.min_area >= 1.0:
+            raise InputError(
+                f"min area must be below 1 (a fraction of the image), got {self.min_area}"
+            )
 
-    # optimization (stage 3 and 4)
+    def min_pixels(self, width: int, height: int) -> float:
+        """Components smaller than this many pixels never become paths (stages 1, 2 and 4)."""
+        return max(4.0, self.min_area * height * width)
+
+
+@dataclass(frozen=True)
+class TraceOptions:
+    """Stage 2: mask components to closed cubic paths."""
+
+    segments: int = 5
+    """Cubic segments per path."""
+
+    def __post_init__(self) -> None:
+        _check_integer(self, "segments", 1)
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """Stages 3 and 4: Adam through the rasterizer on MSE + Xing + LPIPS."""
+
     iterations: int = 500
-    """Adam steps per optimization phase (after tracing, and again after stage 4)."""
+    """Adam steps per optimization phase (after tracing, and again after each stage-4 round)."""
     point_learning_rate: float = 1.0
     colour_learning_rate: float = 0.01
     xing_weight: float = 0.01
@@ -53,8 +118,24 @@ class Config:
     """LPIPS is computed on the render resized to this longest side (cost, not quality)."""
     lpips_weights: str | None = None
 
-    # missing components (stage 4)
+    def __post_init__(self) -> None:
+        _check_integer(self, "iterations", 0)
+        _check_integer(self, "lpips_size", 32)
+        for name in ("point_learning_rate", "colour_learning_rate", "xing_weight", "lpips_weight"):
+            _check_non_negative(self, name)
+
+    @property
+    def wants_lpips(self) -> bool:
+        return self.use_lpips and self.lpips_weight > 0 and self.iterations > 0
+
+
+@dataclass(frozen=True)
+class MissingOptions:
+    """Stage 4: paths added where the optimized render still differs from the image."""
+
     missing_components: bool = True
+    missing_rounds: int = 1
+    """Rounds of stage 4 (error map → SAM → trace → fit); the paper runs one."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015
@@ -62,7 +143,41 @@ class Config:
     """Stage 4 filters by impact against the optimized render, where any gain is on top of a good
     fit: small parts (eyes) gain little as flat colour, so the bar is lower than in stage 1."""
 
-    # product
+    def __post_init__(self) -> None:
+        _check_integer(self, "missing_rounds", 0)
+        _check_non_negative(self, "missing_threshold")
+        _check_non_negative(self, "missing_impact_threshold")
+        _check_radius(self, "missing_radius")
+
+    @property
+    def rounds(self) -> int:
+        return self.missing_rounds if self.missing_components else 0
+
+
+_GROUPS = {
+    "segment": SegmentOptions,
+    "trace": TraceOptions,
+    "fit": FitOptions,
+    "missing": MissingOptions,
+}
+_GROUP_OF = {
+    option.name: group for group, kind in _GROUPS.items() for option in dataclasses.fields(kind)
+}
+
+
+@dataclass(frozen=True, init=False)
+class Config:
+    """Settings of :func:`samvg.vectorize`, one group per stage plus the run's own.
+
+    ``Config()`` and ``Config.paper()`` are the paper's procedure, ``Config.fast()`` the quick
+    preset. Any setting of a group can also be given by name: ``Config(iterations=300)`` is
+    ``Config(fit=FitOptions(iterations=300))``; the same holds for the presets and `replace`.
+    """
+
+    segment: SegmentOptions
+    trace: TraceOptions
+    fit: FitOptions
+    missing: MissingOptions
     size: int = 512
     """Working resolution (longest side); the SVG keeps the input's pixel coordinates."""
     seed: int = 0
@@ -71,59 +186,55 @@ class Config:
     """torch threads for SAM (None = torch's default). Fitting always runs on one thread: its
     tensors are small, and a thread pool stalls whenever another process holds a core."""
 
-    def __post_init__(self) -> None:
-        if self.model not in SAM_MODELS:
-            raise InputError(
-                f"unknown SAM model {self.model!r}; choose one of {', '.join(SAM_MODELS)}"
-            )
-        at_least = {
-            "points_per_side": 1,
-            "crop_n_layers": 0,
-            "segments": 1,
-            "iterations": 0,
-            "size": 8,
-            "lpips_size": 32,
+    def __init__(
+        self,
+        segment: SegmentOptions | None = None,
+        trace: TraceOptions | None = None,
+        fit: FitOptions | None = None,
+        missing: MissingOptions | None = None,
+        *,
+        size: int = 512,
+        seed: int = 0,
+        device: str = "cpu",
+        threads: int | None = None,
+        **settings: Any,
+    ) -> None:
+        groups: dict[str, Any] = {
+            "segment": segment or SegmentOptions(),
+            "trace": trace or TraceOptions(),
+            "fit": fit or FitOptions(),
+            "missing": missing or MissingOptions(),
         }
-        for name, smallest in at_least.items():
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < smallest:
-                raise InputError(f"{_label(name)} must be an integer >= {smallest}, got {value!r}")
-        if self.max_paths is not None and (
-            isinstance(self.max_paths, bool)
-            or not isinstance(self.max_paths, int)
-            or self.max_paths < 1
+        for name, value in settings.items():
+            group = _GROUP_OF.get(name)
+            if group is None:
+                raise InputError(f"unknown setting {name!r}")
+            groups[group] = dataclasses.replace(groups[group], **{name: value})
+        for group, value in groups.items():
+            if not isinstance(value, _GROUPS[group]):
+                raise InputError(f"{group} settings must be {_GROUPS[group].__name__}")
+            object.__setattr__(self, group, value)
+        object.__setattr__(self, "size", size)
+        object.__setattr__(self, "seed", seed)
+        object.__setattr__(self, "device", device)
+        object.__setattr__(self, "threads", threads)
+        self._check()
+
+    def _check(self) -> None:
+        _check_integer(self, "size", 8)
+        if self.threads is not None:
+            _check_integer(self, "threads", 1)
+        _check_integer(self, "seed", 0)
+        if not isinstance(self.device, str) or not (
+            self.device == "cpu" or self.device.startswith(("cuda", "mps"))
         ):
-            raise InputError(f"max paths must be a positive integer, got {self.max_paths!r}")
-        non_negative = (
-            "impact_threshold",
-            "missing_impact_threshold",
-            "min_area",
-            "point_learning_rate",
-            "colour_learning_rate",
-            "xing_weight",
-            "lpips_weight",
-            "missing_threshold",
-        )
-        for name in non_negative:
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not 0.0 <= float(value) < float("inf"):
-                raise InputError(f"{_label(name)} must be a finite number >= 0, got {value!r}")
-        for name in ("uncovered_radius", "missing_radius"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not 0.0 < float(value) <= 0.5:
-                raise InputError(f"{_label(name)} must be in (0, 0.5], got {value!r}")
-        if self.min_area >= 1.0:
-            raise InputError(
-                f"min area must be below 1 (a fraction of the image), got {self.min_area}"
-            )
-        if self.threads is not None and (
-            isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1
-        ):
-            raise InputError(f"threads must be a positive integer, got {self.threads!r}")
-        if not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0:
-            raise InputError(f"seed must be a non-negative integer, got {self.seed!r}")
-        if self.device != "cpu" and not self.device.startswith(("cuda", "mps")):
             raise InputError(f"device must be cpu, cuda[:N] or mps, got {self.device!r}")
+
+    @classmethod
+    def paper(cls, **overrides: Any) -> Config:
+        """The paper's procedure: 32x32 grid, 5 segments, 500 + 500 steps, LPIPS, one stage-4
+        round (the default)."""
+        return cls(**overrides)
 
     @classmethod
     def fast(cls, **overrides: Any) -> Config:
@@ -138,9 +249,21 @@ class Config:
         return cls(**settings)
 
     def replace(self, **changes: Any) -> Config:
-        """A copy with some settings changed (checked again)."""
-        return dataclasses.replace(self, **changes)
+        """A copy with some settings changed, by group or by name (checked again)."""
+        current: dict[str, Any] = {name: getattr(self, name) for name in (*_GROUPS, *_RUN)}
+        for name, value in changes.items():
+            if name in current:
+                current[name] = value
+        flat = {name: value for name, value in changes.items() if name not in current}
+        return Config(**current, **flat)
+
+    def as_dict(self) -> dict[str, Any]:
+        """Every setting by name, flat (for reports and JSON)."""
+        flat: dict[str, Any] = {}
+        for group in _GROUPS:
+            flat.update(dataclasses.asdict(getattr(self, group)))
+        flat.update({name: getattr(self, name) for name in _RUN})
+        return flat
 
 
-def _label(name: str) -> str:
-    return name.replace("_", " ")
+_RUN = ("size", "seed", "device", "threads")

@@ -1,35 +1,51 @@
-"""The SAMVG pipeline: segment (stage 1), trace (2), optimize (3), add missing components and
-optimize again (4). `run` returns every intermediate result; `vectorize` just the SVG.
+"""The SAMVG pipeline as a short driver over the stage functions: segment (stage 1) → trace (2)
+→ fit (3) → add missing components, as many rounds as asked (4) → finish. `run` returns every
+intermediate result; `vectorize` just the SVG.
+
+Each stage owns its settings: they are derived here once from `Config`, in working pixels.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import torch
 
 from samvg.config import Config
-from samvg.errors import SamvgError, WeightsError
-from samvg.io import read_image, to_rgb_uint8
-from samvg.vector_image import VectorImage, VectorPath
+from samvg.errors import WeightsError
+from samvg.imaging import resize_longest, to_float_rgb, to_rgb_uint8
+from samvg.io import read_image
+from samvg.missing import MissingSettings, add_missing
+from samvg.optimize import FitSettings, fit_scene
+from samvg.scene import Frame, Scene
+from samvg.segment import Segmenter, SegmentSettings, select_masks
+from samvg.trace.stage import TraceSettings, trace_scene, uncovered_background
+from samvg.vector_image import VectorImage
 
 ProgressCallback = Callable[[str, int, int], None]
 """``progress(stage, done, total)``: called as each stage advances."""
+LogCallback = Callable[[str], None]
 
-STAGES = ("segment", "trace", "optimize", "missing", "refine")
 UNIFORM_TOLERANCE = 1.5 / 255.0
 MIN_WORKING_SIDE = 8
 
 
 @dataclass
 class PipelineResult:
-    """The final SVG and what the stages produced on the way (working-resolution images)."""
+    """The final SVG and what the stages produced on the way.
+
+    ``scene`` is the final scene in working pixels; ``image``, ``initial`` and ``optimized``
+    are in the input's pixels; ``target``, ``masks`` and ``missing_map`` at working size.
+    """
 
     image: VectorImage
+    scene: Scene | None = None
     initial: VectorImage | None = None
     optimized: VectorImage | None = None
     target: np.ndarray | None = None
@@ -50,203 +66,143 @@ def load_input(image: Any) -> np.ndarray:
     return to_rgb_uint8(image)
 
 
-def working_image(original: np.ndarray, size: int) -> tuple[np.ndarray, float]:
-    """Downscale so the longer side is at most ``size`` (Lanczos); returns (image, scale)."""
-    from PIL import Image
-
-    height, width = original.shape[:2]
-    scale = min(1.0, size / max(height, width))
-    if scale == 1.0:
-        return original, 1.0
-    new_size = (max(2, round(width * scale)), max(2, round(height * scale)))
-    resized = np.asarray(Image.fromarray(original).resize(new_size, Image.Resampling.LANCZOS))
-    return resized, new_size[0] / width
+@contextlib.contextmanager
+def _timed(result: PipelineResult, stage: str) -> Iterator[None]:
+    clock = time.perf_counter()
+    yield
+    result.timings[stage] = result.timings.get(stage, 0.0) + time.perf_counter() - clock
 
 
-def fit_options(config: Config, target: np.ndarray | None = None) -> dict[str, Any]:
-    """The keyword arguments of `samvg.optimize.fit_paths` for one optimization phase.
-
-    With ``target`` and ``config.use_lpips`` the LPIPS loss is loaded and bound to it (raises
-    `WeightsError` when its weights cannot be found); baselines use this to run with exactly
-    the losses and budget samvg uses.
-    """
-    options: dict[str, Any] = {
-        "steps": config.iterations,
-        "point_learning_rate": config.point_learning_rate,
-        "colour_learning_rate": config.colour_learning_rate,
-        "xing_weight": config.xing_weight,
-    }
-    if target is not None and config.use_lpips and config.lpips_weight > 0:
-        options["lpips"] = perceptual_loss(target, config)
-        options["lpips_weight"] = config.lpips_weight
-    return options
-
-
-def perceptual_loss(target: np.ndarray, config: Config) -> Callable:
-    """LPIPS of a render against ``target``, both resized to ``config.lpips_size`` (long side)."""
-    import torch
-    import torch.nn.functional as functional
-
-    from samvg.metrics import load_lpips
-
-    model = load_lpips(config.lpips_weights)
-    height, width = target.shape[:2]
-    factor = min(1.0, config.lpips_size / max(height, width))
-    size = (max(16, round(height * factor)), max(16, round(width * factor)))
-
-    def prepare(image: torch.Tensor) -> torch.Tensor:
-        batch = image.permute(2, 0, 1)[None]
-        if size != (height, width):
-            batch = functional.interpolate(batch, size=size, mode="bilinear", antialias=True)
-        return batch
-
-    target_batch = prepare(torch.from_numpy(np.ascontiguousarray(target, dtype=np.float32)))
-    against_target = model.fixed_target(target_batch)
-
-    def loss(rendered: torch.Tensor) -> torch.Tensor:
-        return against_target(prepare(rendered)).mean()
-
-    return loss
+@contextlib.contextmanager
+def _torch_threads(threads: int | None) -> Iterator[None]:
+    previous = torch.get_num_threads()
+    if threads is not None:
+        torch.set_num_threads(threads)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(previous)
 
 
 def run(
     image: Any,
     config: Config | None = None,
     progress: ProgressCallback | None = None,
-    log: Callable[[str], None] | None = None,
+    log: LogCallback | None = None,
 ) -> PipelineResult:
     """Vectorize ``image`` (a path, numpy array or PIL image) with every stage's output kept.
 
     Raises `InputError` for unusable input and `WeightsError` for missing SAM weights. LPIPS
     weights that cannot be found only switch the LPIPS term off (noted in ``result.notes``).
     """
-    import torch
-
     config = config or Config()
-    threads = torch.get_num_threads()
-    if config.threads is not None:
-        torch.set_num_threads(config.threads)
-    try:
-        return _run(image, config, progress, log)
-    finally:
-        torch.set_num_threads(threads)
-
-
-def _run(
-    image: Any,
-    config: Config,
-    progress: ProgressCallback | None,
-    log: Callable[[str], None] | None,
-) -> PipelineResult:
-    import torch
-
     report = progress or (lambda _stage, _done, _total: None)
     say = log or (lambda _text: None)
     started = time.perf_counter()
-    original = load_input(image)
-    working, scale = working_image(original, config.size)
-    height, width = working.shape[:2]
-    target = working.astype(np.float32) / 255.0
-    result = PipelineResult(image=VectorImage(original.shape[1], original.shape[0]), scale=scale)
-    result.target = target
+    with _torch_threads(config.threads):
+        original = load_input(image)
+        working, scale = resize_longest(original, config.size)
+        target = to_float_rgb(working)
+        frame = Frame(original.shape[1], original.shape[0], scale)
+        result = PipelineResult(image=VectorImage(frame.width, frame.height), scale=scale)
+        result.target = target
+        if not _is_flat(target, frame, result):
+            _run_stages(working, target, frame, config, result, report, say)
+    result.timings["total"] = time.perf_counter() - started
+    return result
 
-    mean_colour = tuple(float(v) for v in target.reshape(-1, 3).mean(axis=0, dtype=np.float64))
-    if (
-        min(height, width) < MIN_WORKING_SIDE
-        or np.ptp(target, axis=(0, 1)).max() <= UNIFORM_TOLERANCE
-    ):
-        reason = "tiny" if min(height, width) < MIN_WORKING_SIDE else "uniform"
-        result.notes.append(f"{reason} image: one background colour, no paths")
-        result.image = VectorImage(original.shape[1], original.shape[0], background=mean_colour)
-        result.mse = float(np.mean((target - np.asarray(mean_colour, np.float32)) ** 2))
-        result.timings["total"] = time.perf_counter() - started
-        return result
 
+def _is_flat(target: np.ndarray, frame: Frame, result: PipelineResult) -> bool:
+    """A tiny or uniform image becomes one background colour: no paths, no SAM."""
+    height, width = target.shape[:2]
+    tiny = min(height, width) < MIN_WORKING_SIDE
+    if not tiny and np.ptp(target, axis=(0, 1)).max() > UNIFORM_TOLERANCE:
+        return False
+    mean = target.reshape(-1, 3).mean(axis=0, dtype=np.float64)
+    colour = (float(mean[0]), float(mean[1]), float(mean[2]))
+    result.notes.append(f"{'tiny' if tiny else 'uniform'} image: one background colour, no paths")
+    result.scene = Scene(width, height, background=colour, frame=frame)
+    result.image = VectorImage.from_scene(result.scene)
+    result.mse = float(np.mean((target - np.asarray(colour, np.float32)) ** 2))
+    return True
+
+
+def _fit_settings(
+    config: Config, target: np.ndarray, result: PipelineResult, say: LogCallback
+) -> FitSettings:
+    """Stage 3's settings; LPIPS weights that cannot be found switch LPIPS off, with a note."""
+    try:
+        return FitSettings.from_options(config.fit, target)
+    except (WeightsError, ImportError) as error:
+        result.notes.append(f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}")
+        say(result.notes[-1])
+        return FitSettings.from_options(config.fit)
+
+
+def _progress_of(report: ProgressCallback, stage: str, steps: int) -> Callable[[int, float], None]:
+    return lambda step, _loss: report(stage, step + 1, steps)
+
+
+def _run_stages(
+    working: np.ndarray,
+    target: np.ndarray,
+    frame: Frame,
+    config: Config,
+    result: PipelineResult,
+    report: ProgressCallback,
+    say: LogCallback,
+) -> None:
+    height, width = target.shape[:2]
     torch.manual_seed(config.seed)
-    from samvg.render import render_array
-    from samvg.segment import (
-        Segmenter,
-        min_component_pixels,
-        missing_component_map,
-        missing_component_prompts,
-        missing_masks,
-        select_masks,
-    )
-
-    # Stage 1
-    clock = time.perf_counter()
-    report("segment", 0, 1)
-    segmenter = Segmenter(config)
-    selection = select_masks(working, segmenter, config)
-    report("segment", 1, 1)
-    result.timings["segment"] = time.perf_counter() - clock
+    with _timed(result, "segment"):
+        report("segment", 0, 1)
+        segmenter = Segmenter(config.segment, config.device)
+        settings = SegmentSettings.from_config(config, width, height)
+        selection = select_masks(working, segmenter, settings)
+        report("segment", 1, 1)
+    result.masks = selection.masks
     result.counts.update(
         amg_masks=selection.amg_masks,
         amg_components=selection.amg_components,
         kept_masks=selection.kept_after_filter,
         reprompt_masks=selection.reprompt_masks,
     )
-    result.masks = selection.masks
+    trace_settings = TraceSettings.from_config(config, width, height)
+    with _timed(result, "trace"):
+        report("trace", 0, 1)
+        traced = trace_scene(selection.masks, target, trace_settings)
+        background = uncovered_background(selection.masks, target)
+        scene = replace(traced, background=background, frame=frame)
+        report("trace", 1, 1)
+    result.initial = VectorImage.from_scene(scene)
+    result.counts["paths_initial"] = scene.path_count
 
-    # Stage 2
-    clock = time.perf_counter()
-    min_pixels = min_component_pixels(config, height, width)
-    points, colours = _trace(selection.masks, target, config.segments, min_pixels, report)
-    covered = np.zeros((height, width), dtype=bool)
-    for mask in selection.masks:
-        covered |= mask
-    background = (
-        tuple(float(v) for v in target[~covered].mean(axis=0)) if (~covered).any() else mean_colour
-    )
-    result.initial = _to_image(points, colours, background, original.shape, scale)
-    result.timings["trace"] = time.perf_counter() - clock
-    result.counts["paths_initial"] = len(points)
+    fit = _fit_settings(config, target, result, say)
+    with _timed(result, "optimize"):
+        scene = fit_scene(scene, target, fit, _progress_of(report, "optimize", fit.steps)).scene
+    result.optimized = VectorImage.from_scene(scene)
 
-    # Stage 3
-    clock = time.perf_counter()
-    options = fit_options(config)
-    if config.use_lpips and config.lpips_weight > 0 and config.iterations > 0:
-        try:
-            options = fit_options(config, target)
-        except (WeightsError, ImportError) as error:
-            first_line = str(error).splitlines()[0]
-            result.notes.append(f"LPIPS off (MSE + Xing only): {first_line}")
-            say(result.notes[-1])
-    fit = _fit(points, colours, target, background, options, "optimize", report)
-    points, colours = fit.points, fit.colours
-    result.optimized = _to_image(points, colours, background, original.shape, scale)
-    result.timings["optimize"] = time.perf_counter() - clock
-
-    # Stage 4
-    if config.missing_components:
-        clock = time.perf_counter()
+    missing = MissingSettings.from_config(config, width, height)
+    result.counts.update(missing_prompts=0, missing_paths=0)
+    for _ in range(missing.rounds):
         report("missing", 0, 1)
-        render = render_array(points, colours, width, height, background)
-        radius = config.missing_radius * max(height, width)
-        averaged, above = missing_component_map(target, render, radius, config.missing_threshold)
-        prompts = missing_component_prompts(averaged, above)
-        result.missing_map = averaged
-        result.missing_prompts = prompts
-        new_masks = missing_masks(segmenter, prompts, target, render, config)
-        new_points, new_colours = _trace(new_masks, target, config.segments, min_pixels, None)
+        on_step = _progress_of(report, "refine", fit.steps)
+        round_ = add_missing(scene, target, segmenter, missing, trace_settings, fit, on_step)
         report("missing", 1, 1)
-        result.counts["missing_prompts"] = len(prompts)
-        result.counts["missing_paths"] = len(new_points)
-        result.timings["missing"] = time.perf_counter() - clock
-        if len(new_points):
-            clock = time.perf_counter()
-            points = np.concatenate([points, new_points])
-            colours = np.concatenate([colours, new_colours])
-            fit = _fit(points, colours, target, background, options, "refine", report)
-            points, colours = fit.points, fit.colours
-            result.timings["refine"] = time.perf_counter() - clock
+        scene = round_.scene
+        result.missing_map, result.missing_prompts = round_.error_map, round_.prompts
+        result.counts["missing_prompts"] += len(round_.prompts)
+        result.counts["missing_paths"] += round_.added
+        for stage, seconds in round_.timings.items():
+            result.timings[stage] = result.timings.get(stage, 0.0) + seconds
+    _finish(scene, target, result)
 
-    result.image = _to_image(points, colours, background, original.shape, scale)
-    final_render = render_array(points, colours, width, height, background)
-    result.mse = float(np.mean((final_render - target) ** 2))
-    result.counts["paths"] = len(result.image.paths)
-    result.timings["total"] = time.perf_counter() - started
-    return result
+
+def _finish(scene: Scene, target: np.ndarray, result: PipelineResult) -> None:
+    result.scene = scene
+    result.image = VectorImage.from_scene(scene)
+    result.mse = float(np.mean((scene.render() - target) ** 2))
+    result.counts["paths"] = scene.path_count
 
 
 def vectorize(
@@ -258,50 +214,3 @@ def vectorize(
     and machine give the same SVG.
     """
     return run(image, config, progress).image
-
-
-def _trace(
-    masks: list[np.ndarray],
-    target: np.ndarray,
-    segments: int,
-    min_pixels: float,
-    report: ProgressCallback | None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Every component of every mask as a path: points (P, 3K, 2) and RGBA colours (P, 4)."""
-    from samvg.trace import trace_masks
-
-    if report is not None:
-        report("trace", 0, 1)
-    traced = trace_masks(masks, target, segments_per_path=segments, min_area=min_pixels)
-    if report is not None:
-        report("trace", 1, 1)
-    points, colours = traced.stacked_paths()
-    return (
-        points.reshape(len(traced.paths), 3 * segments, 2),
-        colours.reshape(len(traced.paths), 4),
-    )
-
-
-def _fit(points, colours, target, background, options, stage, report):  # type: ignore[no-untyped-def]
-    from samvg.optimize import fit_paths
-
-    steps = options["steps"]
-    fit = fit_paths(
-        points,
-        colours,
-        target,
-        background=background,
-        on_step=lambda step, _loss: report(stage, step + 1, steps),
-        **options,
-    )
-    if not (np.all(np.isfinite(fit.points)) and np.all(np.isfinite(fit.colours))):
-        raise SamvgError("optimization diverged (non-finite coordinates); try fewer iterations")
-    return fit
-
-
-def _to_image(points, colours, background, shape, scale) -> VectorImage:  # type: ignore[no-untyped-def]
-    paths = [
-        VectorPath(p / scale, tuple(np.clip(c, 0.0, 1.0)))
-        for p, c in zip(points, colours, strict=True)
-    ]
-    return VectorImage(shape[1], shape[0], paths, background=background)

@@ -32,6 +32,7 @@ import zipfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO, Protocol
 
 from samvg.errors import WeightsError
 from samvg.io import replace_with_default_permissions
@@ -107,7 +108,18 @@ def verify_file(spec: WeightSpec, path: str | os.PathLike[str]) -> None:
             raise WeightsError(f"{spec.name}: {p} has sha256 {digest}, expected {spec.sha256}")
 
 
-def _progress_copy(src, dst, total: int | None, label: str, progress: bool, hasher=None) -> int:
+class _Hasher(Protocol):
+    def update(self, data: bytes, /) -> None: ...
+
+
+def _progress_copy(
+    src: IO[bytes],
+    dst: IO[bytes],
+    total: int | None,
+    label: str,
+    progress: bool,
+    hasher: _Hasher | None = None,
+) -> int:
     """Copy a binary stream to another, updating a rich progress bar and an optional hasher."""
     n = 0
     if progress:
@@ -180,11 +192,11 @@ def _extract_member(archive: Path, member: str, dst_path: Path) -> str:
                 info = tf.getmember(member)
             except KeyError:
                 raise OSError(f"archive has no member {member!r}") from None
-            src = tf.extractfile(info)
-            if src is None:
+            extracted = tf.extractfile(info)
+            if extracted is None:
                 raise OSError(f"archive member {member!r} is not a regular file")
-            with src, open(dst_path, "wb") as out:
-                _progress_copy(src, out, None, "", False, h)
+            with extracted, open(dst_path, "wb") as out:
+                _progress_copy(extracted, out, None, "", False, h)
     except tarfile.TarError as e:
         raise OSError(f"not a valid tar or zip archive: {e}") from None
     return h.hexdigest()

@@ -125,16 +125,21 @@ def test_invalid_paths_and_canvas_are_rejected():
         VectorImage(0, 10)
 
 
-def test_stacked_paths_pad_with_zero_length_segments():
+def test_paths_of_different_lengths_are_packed_in_one_scene():
     image = VectorImage(
         10,
         10,
         [VectorPath(np.arange(6.0).reshape(3, 2)), VectorPath(np.arange(12.0).reshape(6, 2))],
     )
-    points, colours = image.stacked_paths()
-    assert points.shape == (2, 6, 2) and colours.shape == (2, 4)
-    np.testing.assert_allclose(points[0, :3], [[0, 1]] * 3)
-    np.testing.assert_allclose(points[0, 3:], image.paths[0].points)
+    scene = image.scene
+    assert scene.points.shape == (9, 2) and list(scene.offsets) == [0, 3, 9]
+    assert list(scene.segment_counts()) == [1, 2] and scene.colours().shape == (2, 4)
+    np.testing.assert_allclose(image.paths[1].points, np.arange(12.0).reshape(6, 2))
+
+
+def test_nan_points_are_refused_at_construction():
+    with pytest.raises(InputError, match="finite"):
+        VectorPath(np.full((3, 2), np.nan))
 
 
 def test_save_is_atomic(tmp_path, monkeypatch):

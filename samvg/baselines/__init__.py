@@ -7,9 +7,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
 import numpy as np
 
 from samvg.baselines.common import WHITE, StepProgress, as_target, blob
@@ -17,11 +14,13 @@ from samvg.baselines.live import live, schedule
 from samvg.baselines.random_init import random_blobs, random_init
 from samvg.baselines.vtracer_baseline import TracedSvg, render_svg, vtracer_trace
 from samvg.errors import InputError
+from samvg.optimize import FitSettings
+from samvg.scene import RGB, Scene
 from samvg.vector_image import VectorImage
 
 BASELINES = ("diffvg", "live", "vtracer")
 #: samvg optimises in two phases (after tracing, after adding missing components); a baseline
-#: given only ``fit_options["steps"]`` (one phase) gets this many times as many steps.
+#: given only samvg's `FitSettings` (one phase) gets this many times its steps.
 SAMVG_PHASES = 2
 
 Vectorized = VectorImage | TracedSvg
@@ -31,53 +30,58 @@ def run_baseline(
     name: str,
     target: np.ndarray,
     path_count: int,
-    fit_options: Mapping[str, Any] | None = None,
+    fit: FitSettings | None = None,
     seed: int = 0,
     *,
     steps: int | None = None,
     segments: int = 5,
-    background: tuple[float, float, float] = WHITE,
+    background: RGB = WHITE,
     progress: StepProgress | None = None,
 ) -> Vectorized:
     """Vectorize ``target`` (uint8 or float RGB) with baseline ``name`` and ``path_count`` paths.
 
-    ``fit_options`` are the keyword arguments samvg gives :func:`samvg.optimize.fit_paths` for
-    one phase (``samvg.pipeline.fit_options(config)``); the optimising baselines run
-    ``steps`` steps in all, by default ``SAMVG_PHASES * fit_options["steps"]``, so they get
-    samvg's iterations and losses. ``vtracer`` ignores the fitting arguments.
+    ``fit`` are the settings samvg fits one phase with (its losses, learning rates and steps);
+    the optimising baselines run ``steps`` steps in all, by default ``SAMVG_PHASES *
+    fit.steps``, so they get samvg's iterations and losses. ``vtracer`` ignores the fitting
+    arguments. Optimising baselines come back as a `VectorImage` on the target's canvas.
     """
     if name not in BASELINES:
         raise InputError(f"unknown baseline {name!r}; choose from {', '.join(BASELINES)}")
     if name == "vtracer":
         return vtracer_trace(target, path_count)
     if steps is None:
-        if not fit_options or "steps" not in fit_options:
-            raise InputError("give steps, or fit_options with samvg's steps per phase")
-        steps = SAMVG_PHASES * int(fit_options["steps"])
+        if fit is None:
+            raise InputError("give steps, or samvg's fit settings (steps per phase)")
+        steps = SAMVG_PHASES * fit.steps
     method = random_init if name == "diffvg" else live
-    return method(
+    scene = method(
         target,
         path_count,
+        fit,
         steps=steps,
         segments=segments,
         seed=seed,
         background=background,
-        fit_options=fit_options,
         progress=progress,
     )
+    return VectorImage.from_scene(scene)
 
 
-def path_count(result: Vectorized) -> int:
+def path_count(result: Vectorized | Scene) -> int:
     """Number of paths (a background colour or rectangle of a VectorImage is not counted)."""
-    return result.path_count if isinstance(result, TracedSvg) else len(result.paths)
+    if isinstance(result, TracedSvg):
+        return result.path_count
+    scene = result if isinstance(result, Scene) else result.scene
+    return scene.path_count
 
 
-def parameter_count(result: Vectorized) -> int:
+def parameter_count(result: Vectorized | Scene) -> int:
     """All coordinates and colour values: 6K + 4 per path of K cubic segments (34 for K = 5,
     the paper's count); for VTracer, every number of its path data and transforms plus RGB."""
     if isinstance(result, TracedSvg):
         return result.parameter_count
-    return sum(6 * path.num_segments + 4 for path in result.paths)
+    scene = result if isinstance(result, Scene) else result.scene
+    return scene.parameter_count
 
 
 __all__ = [

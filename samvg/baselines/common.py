@@ -1,16 +1,15 @@
-"""Helpers the baselines share: target conversion, circular blobs as cubic paths, fit options."""
+"""Helpers the baselines share: target conversion, argument checks, circular blobs as cubic
+paths."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
-from typing import Any
+from collections.abc import Callable
 
 import numpy as np
 
 from samvg.errors import InputError
-from samvg.io import to_rgb_uint8
-from samvg.vector_image import VectorImage, VectorPath
+from samvg.imaging import to_float_rgb
 
 StepProgress = Callable[[int, int], None]
 """``progress(done, total)``: optimisation steps finished out of the baseline's total."""
@@ -19,24 +18,8 @@ WHITE = (1.0, 1.0, 1.0)
 
 
 def as_target(image: np.ndarray) -> np.ndarray:
-    """An (H, W, 3) float32 copy of ``image`` in [0, 1].
-
-    Float images already in [0, 1] are kept as they are; anything else goes through
-    :func:`samvg.io.to_rgb_uint8` (grey, alpha, uint16, PIL images ...).
-    """
-    array = np.asarray(image)
-    if (
-        array.ndim == 3
-        and array.shape[2] == 3
-        and np.issubdtype(array.dtype, np.floating)
-        and array.size
-        and np.isfinite(array).all()
-        and array.min() >= 0.0
-        and array.max() <= 1.0
-        and min(array.shape[:2]) >= 2
-    ):
-        return array.astype(np.float32)
-    return to_rgb_uint8(image).astype(np.float32) / 255.0
+    """An (H, W, 3) float32 copy of ``image`` in [0, 1] (see `samvg.imaging.to_float_rgb`)."""
+    return to_float_rgb(image, "target")
 
 
 def check_counts(path_count: int, segments: int) -> None:
@@ -72,29 +55,8 @@ def blob(
     return points
 
 
-def fit_arguments(fit_options: Mapping[str, Any] | None) -> dict[str, Any]:
-    """The keyword arguments for :func:`samvg.optimize.fit_paths` from ``fit_options``.
-
-    ``steps`` is dropped (each baseline sets its own step budget) and so are ``background``
-    and ``on_step``, which the baselines manage themselves.
-    """
-    options = dict(fit_options or {})
-    for key in ("steps", "background", "on_step"):
-        options.pop(key, None)
-    return options
-
-
-def to_vector_image(
-    points: np.ndarray,
-    colours: np.ndarray,
-    width: int,
-    height: int,
-    background: tuple[float, float, float],
-) -> VectorImage:
-    """Fitted arrays as a :class:`VectorImage`; a diverged fit raises :class:`InputError`."""
-    if not (np.all(np.isfinite(points)) and np.all(np.isfinite(colours))):
-        raise InputError("optimisation diverged (non-finite coordinates or colours)")
-    paths = [
-        VectorPath(p, tuple(np.clip(c, 0.0, 1.0))) for p, c in zip(points, colours, strict=True)
-    ]
-    return VectorImage(width, height, paths, background=background)
+def check_steps(steps: object) -> int:
+    """``steps`` as an int, or :class:`InputError` unless it is an integer >= 0."""
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
+        raise InputError(f"steps must be an integer >= 0, got {steps!r}")
+    return int(steps)

@@ -3,14 +3,12 @@ circle at the centre of one of the largest regions of high error, all paths so f
 after each addition.
 
 LIVE's UDF-weighted loss and its Xing loss schedule are not reproduced: every stage uses the
-losses of ``fit_options`` (samvg's own), so the baselines differ only in initialization.
+losses of the given `FitSettings` (samvg's own), so the baselines differ only in initialization.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -21,11 +19,11 @@ from samvg.baselines.common import (
     as_target,
     blob,
     check_counts,
-    fit_arguments,
-    to_vector_image,
+    check_steps,
 )
-from samvg.errors import InputError
-from samvg.vector_image import VectorImage
+from samvg.imaging import error_map
+from samvg.optimize import FitSettings, fit_scene
+from samvg.scene import RGB, FlatPaint, Scene
 
 #: A pixel is "high error" when |render - target| summed over RGB exceeds this.
 ERROR_THRESHOLD = 0.15
@@ -53,11 +51,6 @@ def schedule(path_count: int) -> list[int]:
         total += stages[-1]
         size *= 2
     return stages
-
-
-def error_map(render: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """Per-pixel error: the absolute difference summed over the three channels."""
-    return np.abs(np.asarray(render, np.float32) - np.asarray(target, np.float32)).sum(axis=2)
 
 
 def find_seeds(
@@ -116,55 +109,40 @@ def find_seeds(
 def live(
     target: np.ndarray,
     path_count: int,
+    fit: FitSettings | None = None,
     *,
-    steps: int,
+    steps: int | None = None,
     segments: int = 5,
     seed: int = 0,
-    background: tuple[float, float, float] = WHITE,
-    fit_options: Mapping[str, Any] | None = None,
+    background: RGB = WHITE,
     progress: StepProgress | None = None,
-) -> VectorImage:
-    """Vectorize ``target`` with ``path_count`` paths added layer-wise, ``steps`` steps in all.
+) -> Scene:
+    """Vectorize ``target`` with ``path_count`` paths added layer-wise, ``steps`` steps in all
+    (default ``fit.steps``), fitted with ``fit`` (default `FitSettings()`).
 
     The step budget is split evenly over the stages of :func:`schedule` (the remainder goes to
     the last). ``seed`` is accepted for a uniform signature; the method is deterministic.
     """
-
-    from samvg.optimize import fit_paths
-    from samvg.render import render_array
-
     del seed
     check_counts(path_count, segments)
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
-        raise InputError(f"steps must be an integer >= 0, got {steps!r}")
+    fit = fit or FitSettings()
+    total = check_steps(fit.steps if steps is None else steps)
     image = as_target(target)
     height, width = image.shape[:2]
     stages = schedule(path_count)
-    per_stage = [steps // len(stages)] * len(stages)
-    per_stage[-1] += steps - sum(per_stage)
-    options = fit_arguments(fit_options)
-    points = np.zeros((0, 3 * segments, 2))
-    colours = np.zeros((0, 4))
+    per_stage = [total // len(stages)] * len(stages)
+    per_stage[-1] += total - sum(per_stage)
+    scene = Scene(width, height, background=background)
     done = 0
     for added, stage_steps in zip(stages, per_stage, strict=True):
-        render = render_array(points, colours, width, height, background=background)
-        seeds = find_seeds(error_map(render, image), image, added)
-        points = np.concatenate([points, [blob(s.centre, s.radius, segments) for s in seeds]])
-        colours = np.concatenate([colours, [[*s.colour, 1.0] for s in seeds]])
+        seeds = find_seeds(error_map(image, scene.render()), image, added)
+        circles = [(blob(s.centre, s.radius, segments), FlatPaint((*s.colour, 1.0))) for s in seeds]
+        scene = scene.stacked(Scene.from_paths(width, height, circles))
 
         def on_step(step: int, _loss: float, offset: int = done) -> None:
             if progress is not None:
-                progress(offset + step + 1, steps)
+                progress(offset + step + 1, total)
 
-        result = fit_paths(
-            points,
-            colours,
-            image,
-            steps=stage_steps,
-            background=background,
-            on_step=on_step,
-            **options,
-        )
-        points, colours = result.points, result.colours
+        scene = fit_scene(scene, image, fit.with_steps(stage_steps), on_step).scene
         done += stage_steps
-    return to_vector_image(points, colours, width, height, background)
+    return scene

@@ -3,9 +3,6 @@ fitted with samvg's own optimiser, iteration budget and losses."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
 import numpy as np
 
 from samvg.baselines.common import (
@@ -14,11 +11,10 @@ from samvg.baselines.common import (
     as_target,
     blob,
     check_counts,
-    fit_arguments,
-    to_vector_image,
+    check_steps,
 )
-from samvg.errors import InputError
-from samvg.vector_image import VectorImage
+from samvg.optimize import FitSettings, fit_scene
+from samvg.scene import RGB, Scene
 
 #: Blob radius range as fractions of the shorter canvas side.
 RADIUS_RANGE = (0.03, 0.15)
@@ -50,33 +46,25 @@ def random_blobs(
 def random_init(
     target: np.ndarray,
     path_count: int,
+    fit: FitSettings | None = None,
     *,
-    steps: int,
+    steps: int | None = None,
     segments: int = 5,
     seed: int = 0,
-    background: tuple[float, float, float] = WHITE,
-    fit_options: Mapping[str, Any] | None = None,
+    background: RGB = WHITE,
     progress: StepProgress | None = None,
-) -> VectorImage:
-    """Vectorize ``target`` with ``path_count`` random blobs fitted for ``steps`` steps.
-
-    ``fit_options`` are passed to :func:`samvg.optimize.fit_paths` (losses, learning rates),
-    e.g. ``samvg.pipeline.fit_options(config)``; the same ``seed`` gives the same result.
-    """
-    from samvg.optimize import fit_paths
-
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
-        raise InputError(f"steps must be an integer >= 0, got {steps!r}")
+) -> Scene:
+    """Vectorize ``target`` with ``path_count`` random blobs fitted with ``fit`` (samvg's
+    losses and learning rates; default `FitSettings()`) for ``steps`` steps (default
+    ``fit.steps``); the same ``seed`` gives the same result."""
+    fit = fit or FitSettings()
+    fit = fit.with_steps(check_steps(fit.steps if steps is None else steps))
     image = as_target(target)
     height, width = image.shape[:2]
     points, colours = random_blobs(width, height, path_count, segments, np.random.default_rng(seed))
-    result = fit_paths(
-        points,
-        colours,
-        image,
-        steps=int(steps),
-        background=background,
-        on_step=None if progress is None else (lambda step, _loss: progress(step + 1, steps)),
-        **fit_arguments(fit_options),
+    offsets = np.arange(path_count + 1) * 3 * segments
+    scene = Scene.from_arrays(
+        width, height, points.reshape(-1, 2), offsets, colours, background=background
     )
-    return to_vector_image(result.points, result.colours, width, height, background)
+    on_step = None if progress is None else (lambda step, _loss: progress(step + 1, fit.steps))
+    return fit_scene(scene, image, fit, on_step).scene

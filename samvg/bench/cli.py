@@ -9,6 +9,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from samvg.bench.methods import DEFAULT_METHODS, METHODS
+from samvg.bench.report import write_report
+from samvg.bench.runner import run_bench
+from samvg.config import Config
 from samvg.errors import SamvgError
 
 
@@ -17,8 +21,6 @@ def _names(text: str) -> list[str]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from samvg.bench.methods import DEFAULT_METHODS, METHODS
-
     parser = argparse.ArgumentParser(
         prog="samvg-bench",
         description=(
@@ -109,10 +111,6 @@ class _RichProgress:
 
 
 def _run(arguments: argparse.Namespace, console: Any, command: str) -> None:
-    from samvg import Config
-    from samvg.bench.report import write_report
-    from samvg.bench.runner import run_bench
-
     if arguments.report_only:
         summary = write_report(
             arguments.out, fid_weights=arguments.fid_weights, fid=not arguments.no_fid

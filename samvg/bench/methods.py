@@ -9,15 +9,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
+from samvg import pipeline
 from samvg.baselines import SAMVG_PHASES, TracedSvg, Vectorized, run_baseline
+from samvg.config import Config
 from samvg.errors import WeightsError
-
-if TYPE_CHECKING:
-    from samvg import Config
 
 
 @dataclass
@@ -47,11 +46,9 @@ class Method:
 
 def _samvg(config_change: dict[str, Any]) -> Callable[[MethodRun], Vectorized]:
     def vectorize_with_samvg(job: MethodRun) -> Vectorized:
-        from samvg.pipeline import run
-
         config = job.config.replace(**config_change) if config_change else job.config
         uint8 = np.round(job.target * 255.0).astype(np.uint8)
-        result = run(uint8, config, progress=job.progress)
+        result = pipeline.run(uint8, config, progress=job.progress)
         job.details.update(counts=dict(result.counts), notes=list(result.notes))
         job.details["timings"] = {k: round(v, 3) for k, v in result.timings.items()}
         return result.image
@@ -62,15 +59,13 @@ def _samvg(config_change: dict[str, Any]) -> Callable[[MethodRun], Vectorized]:
 def baseline_fit_options(job: MethodRun) -> dict[str, Any]:
     """samvg's fit options for ``job``'s target; without LPIPS weights, samvg's own fallback
     (MSE + Xing), noted in the record."""
-    from samvg.pipeline import fit_options
-
     try:
-        return fit_options(job.config, job.target)
+        return pipeline.fit_options(job.config, job.target)
     except (WeightsError, ImportError) as error:
         job.details.setdefault("notes", []).append(
             f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}"
         )
-        return fit_options(job.config)
+        return pipeline.fit_options(job.config)
 
 
 def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:

@@ -15,10 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from samvg.bench.layout import Layout
 from samvg.bench.measure import fid_scores
 from samvg.bench.methods import DEFAULT_METHODS
-from samvg.bench.runner import Layout
 from samvg.errors import InputError
+from samvg.imaging import to_float_rgb
 from samvg.io import atomic_write_bytes, atomic_write_text, read_image
 
 
@@ -124,7 +125,7 @@ def _markdown_table(
 
 
 def _load_float(path: Path) -> np.ndarray:
-    return read_image(path).astype(np.float32) / 255.0
+    return to_float_rgb(read_image(path), str(path))
 
 
 def _fid_by_method(
@@ -139,7 +140,7 @@ def _fid_by_method(
 
 
 def _save_figure(figure: Any, path: Path) -> None:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # lazy: optional (bench extra)
 
     FigureCanvasAgg(figure)
     buffer = io.BytesIO()
@@ -156,7 +157,7 @@ def _scatter(
     path: Path,
     scale: float = 1.0,
 ) -> None:
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # lazy: matplotlib is optional (bench extra)
 
     figure = Figure(figsize=(6.4, 4.4))
     axes = figure.add_subplot()
@@ -189,7 +190,7 @@ def _scatter(
 def _contact_sheet(
     layout: Layout, records: list[dict[str, Any]], methods: list[str], ids: list[str], path: Path
 ) -> None:
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # lazy: matplotlib is optional (bench extra)
 
     category = {r["id"]: r.get("category", "") for r in records}
     chosen: list[str] = []

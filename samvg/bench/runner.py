@@ -13,7 +13,9 @@ Layout of the output folder::
 
 from __future__ import annotations
 
+import csv
 import dataclasses
+import io
 import json
 import os
 import time
@@ -21,19 +23,20 @@ import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
 from samvg.baselines import Vectorized, parameter_count, path_count
+from samvg.bench.layout import Layout
 from samvg.bench.manifest import BenchImage, read_manifest
 from samvg.bench.measure import IMAGE_METRICS, Scorer
 from samvg.bench.methods import DEFAULT_METHODS, METHODS, Method, MethodRun
+from samvg.bench.report import write_report
+from samvg.config import Config
 from samvg.errors import InputError
+from samvg.imaging import resize_longest, to_float_rgb
 from samvg.io import atomic_write_text, read_image, write_png
-
-if TYPE_CHECKING:
-    from samvg import Config
 
 #: Columns of results.csv, in order (``details`` is JSON text).
 RECORD_FIELDS = (
@@ -89,49 +92,10 @@ class BenchOutcome:
     failed: int = 0
 
 
-class Layout:
-    """Where everything of one benchmark lives under ``out``."""
-
-    def __init__(self, out: Path) -> None:
-        self.out = out
-        self.run_file = out / "run.json"
-        self.results_csv = out / "results.csv"
-
-    def record(self, method: str, image_id: str) -> Path:
-        return self.out / "records" / method / f"{image_id}.json"
-
-    def svg(self, method: str, image_id: str) -> Path:
-        return self.out / "svg" / method / f"{image_id}.svg"
-
-    def render(self, method: str, image_id: str) -> Path:
-        return self.out / "renders" / method / f"{image_id}.png"
-
-    def target(self, image_id: str) -> Path:
-        return self.out / "targets" / f"{image_id}.png"
-
-    def records(self) -> list[dict[str, Any]]:
-        """Every record in the folder, sorted by image id, then method."""
-        found = []
-        for path in sorted((self.out / "records").glob("*/*.json")):
-            try:
-                found.append(json.loads(path.read_text(encoding="utf-8")))
-            except (OSError, json.JSONDecodeError):
-                continue  # a record is written atomically; anything else is not ours
-        return sorted(found, key=lambda r: (r.get("id", ""), r.get("method", "")))
-
-
 def load_target(path: Path, size: int) -> np.ndarray:
     """The image at ``path`` as float32 (H, W, 3) in [0, 1], longer side at most ``size``."""
-    from PIL import Image
-
-    original = read_image(path)
-    height, width = original.shape[:2]
-    scale = min(1.0, size / max(height, width))
-    if scale < 1.0:
-        new_size = (max(2, round(width * scale)), max(2, round(height * scale)))
-        resized = Image.fromarray(original).resize(new_size, Image.Resampling.LANCZOS)
-        original = np.asarray(resized)
-    return original.astype(np.float32) / 255.0
+    resized, _scale = resize_longest(read_image(path), size)
+    return to_float_rgb(resized, str(path))
 
 
 def plan_methods(names: Sequence[str], table: dict[str, Method] | None = None) -> list[Method]:
@@ -201,9 +165,6 @@ def _json_default(value: Any) -> Any:
 
 def write_results_csv(layout: Layout) -> None:
     """results.csv: one row per record (all images and methods in the folder), atomically."""
-    import csv
-    import io
-
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=RECORD_FIELDS, extrasaction="ignore")
     writer.writeheader()
@@ -257,8 +218,6 @@ def run_bench(
     ``command`` (the command line) is kept in run.json and shown in the summary; ``fid=False``
     leaves FID out of the report.
     """
-    from samvg import Config
-
     planned = plan_methods(methods, method_table)
     images = read_manifest(manifest, list(categories) if categories else None, limit)
     changes: dict[str, Any] = {"size": size}
@@ -329,8 +288,6 @@ def run_bench(
                 outcome.failed += 1
             reporter.end(record)
     if report:
-        from samvg.bench.report import write_report
-
         write_results_csv(layout)
         write_report(layout.out, fid_weights=fid_weights, fid=fid)
     return outcome

@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 import warnings
 from collections.abc import Iterable, Sequence
+from typing import TypeAlias
 
 import numpy as np
 import torch
@@ -25,6 +26,7 @@ import torch.nn.functional as F  # noqa: N812
 from scipy import linalg
 
 from samvg.errors import InputError, WeightsError
+from samvg.imaging import to_float_rgb
 from samvg.weights import WeightSource, WeightSpec, resolve_weights
 
 __all__ = [
@@ -40,6 +42,10 @@ ENV_VAR = "SAMVG_FID_WEIGHTS"
 FEATURES = 2048
 INPUT_SIZE = 299
 _PARAMETERS = 21_802_784  # number of parameter values in the pytorch-fid InceptionV3
+
+#: Images as `fid_features` takes them: a sequence of (H, W, 3) arrays or (3, H, W) tensors, or
+#: one (N, H, W, 3) array or (N, 3, H, W) tensor.
+ImageSet: TypeAlias = Sequence[np.ndarray | torch.Tensor] | np.ndarray | torch.Tensor
 
 FID_INCEPTION_SPEC = WeightSpec(
     name="FID InceptionV3",
@@ -96,29 +102,26 @@ def load_fid_inception(
     return model
 
 
-def _as_tensor(image, index: int) -> torch.Tensor:
-    """One image -> (3, H, W) float32 in [0, 1]. Numpy (H, W, 3) uint8 / float, or a tensor."""
+def _as_tensor(image: np.ndarray | torch.Tensor, index: int) -> torch.Tensor:
+    """One image -> (3, H, W) float32 in [0, 1]. Numpy (H, W, 3) uint8 / float in [0, 1]
+    (converted by `samvg.imaging.to_float_rgb`), or a (3, H, W) tensor (used as it is)."""
     if isinstance(image, torch.Tensor):
         t = image.detach().to("cpu", torch.float32)
         if t.dim() != 3 or t.shape[0] != 3:
             raise InputError(f"image {index}: expected a (3, H, W) tensor, got {tuple(t.shape)}")
-    else:
-        arr = np.asarray(image)
-        if arr.ndim != 3 or arr.shape[2] != 3:
-            raise InputError(f"image {index}: expected an (H, W, 3) RGB image, got {arr.shape}")
-        if arr.dtype == np.uint8:
-            arr = arr.astype(np.float32) / 255.0
-        elif np.issubdtype(arr.dtype, np.floating):
-            arr = arr.astype(np.float32)
-        else:
-            raise InputError(f"image {index}: unsupported dtype {arr.dtype}")
-        t = torch.from_numpy(np.ascontiguousarray(arr.transpose(2, 0, 1)))
-    if not torch.isfinite(t).all():
-        raise InputError(f"image {index}: NaN or infinite values")
-    return t
+        if not torch.isfinite(t).all():
+            raise InputError(f"image {index}: NaN or infinite values")
+        return t
+    arr = np.asarray(image)
+    if arr.ndim != 3 or arr.shape[2] != 3:
+        raise InputError(f"image {index}: expected an (H, W, 3) RGB image, got {arr.shape}")
+    if arr.dtype != np.uint8 and not np.issubdtype(arr.dtype, np.floating):
+        raise InputError(f"image {index}: unsupported dtype {arr.dtype}")
+    rgb = to_float_rgb(arr, f"image {index}")
+    return torch.from_numpy(np.ascontiguousarray(rgb.transpose(2, 0, 1)))
 
 
-def _iter_images(images) -> Iterable:
+def _iter_images(images: ImageSet) -> Iterable[np.ndarray | torch.Tensor]:
     if isinstance(images, torch.Tensor) and images.dim() == 4:
         return images.unbind(0)
     if isinstance(images, np.ndarray) and images.ndim == 4:
@@ -136,7 +139,7 @@ def preprocess(image: torch.Tensor) -> torch.Tensor:
 
 def fid_features(
     model: torch.nn.Module,
-    images: Sequence | np.ndarray | torch.Tensor,
+    images: ImageSet,
     *,
     batch_size: int = 16,
 ) -> np.ndarray:
@@ -244,8 +247,8 @@ def frechet_distance(
 
 
 def fid(
-    images_a: Sequence | np.ndarray | torch.Tensor,
-    images_b: Sequence | np.ndarray | torch.Tensor,
+    images_a: ImageSet,
+    images_b: ImageSet,
     weights: str | os.PathLike[str] | torch.nn.Module | None = None,
     *,
     batch_size: int = 16,

@@ -30,6 +30,7 @@ from PIL import Image
 from skimage.metrics import structural_similarity
 
 from samvg.errors import InputError
+from samvg.imaging import to_float_rgb
 
 __all__ = ["complexity", "jpeg_compression", "mse", "psnr", "ssim"]
 
@@ -37,16 +38,16 @@ JPEG_QUALITY = 75
 
 
 def _as_rgb_float(image: np.ndarray, name: str) -> np.ndarray:
+    """An (H, W, 3) uint8 or [0, 1] float image as float64, converted by `to_float_rgb`."""
     arr = np.asarray(image)
     if arr.ndim != 3 or arr.shape[2] != 3:
         raise InputError(f"{name}: expected an (H, W, 3) RGB image, got shape {arr.shape}")
-    if arr.dtype == np.uint8:
-        return arr.astype(np.float64) / 255.0
-    if not np.issubdtype(arr.dtype, np.floating):
+    if arr.dtype != np.uint8 and not np.issubdtype(arr.dtype, np.floating):
         raise InputError(f"{name}: unsupported dtype {arr.dtype} (use uint8 or float in [0, 1])")
-    if not np.isfinite(arr).all():
-        raise InputError(f"{name}: image has NaN or infinite values")
-    return arr.astype(np.float64)
+    rgb = to_float_rgb(arr, name)  # checks the values; float32
+    if arr.dtype == np.float64:
+        return arr.astype(np.float64)  # keep the precision that float32 would round away
+    return rgb.astype(np.float64)
 
 
 def _pair(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -35,6 +35,7 @@ import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import torch
@@ -42,6 +43,7 @@ import torch.nn.functional as F  # noqa: N812
 from torch import nn
 
 from samvg.errors import InputError, WeightsError
+from samvg.imaging import to_float_rgb
 from samvg.io import replace_with_default_permissions
 from samvg.weights import (
     WeightSource,
@@ -245,7 +247,7 @@ class _NumpyOnlyUnpickler(pickle.Unpickler):
         ("numpy", "dtype"): np.dtype,
     }
 
-    def find_class(self, module: str, name: str):
+    def find_class(self, module: str, name: str) -> object:
         try:
             return self._ALLOWED[(module, name)]
         except KeyError:
@@ -432,7 +434,7 @@ class LPIPS(nn.Module):
         total = None
         for a, b, lin in zip(fx, fy, self.lins, strict=True):
             diff = (a - b).square().mean(dim=(2, 3))  # (N, C): spatial mean first
-            term = diff @ lin.weight.view(-1)  # == 1x1 conv head, then spatial mean
+            term = diff @ cast(nn.Conv2d, lin).weight.view(-1)  # == 1x1 conv head, spatial mean
             total = term if total is None else total + term
         assert total is not None
         return total
@@ -480,18 +482,14 @@ class LPIPS(nn.Module):
 
 
 def _image_tensor(image: np.ndarray, name: str) -> torch.Tensor:
+    """An (H, W, 3) uint8 or [0, 1] float image as a (1, 3, H, W) float32 tensor."""
     arr = np.asarray(image)
     if arr.ndim != 3 or arr.shape[2] != 3:
         raise InputError(f"{name}: expected an (H, W, 3) RGB image, got shape {arr.shape}")
-    if arr.dtype == np.uint8:
-        arr = arr.astype(np.float32) / 255.0
-    elif np.issubdtype(arr.dtype, np.floating):
-        if not np.isfinite(arr).all():
-            raise InputError(f"{name}: image has NaN or infinite values")
-        arr = arr.astype(np.float32)
-    else:
+    if arr.dtype != np.uint8 and not np.issubdtype(arr.dtype, np.floating):
         raise InputError(f"{name}: unsupported dtype {arr.dtype} (use uint8 or float in [0, 1])")
-    return torch.from_numpy(np.ascontiguousarray(arr.transpose(2, 0, 1)))[None]
+    rgb = to_float_rgb(arr, name)
+    return torch.from_numpy(np.ascontiguousarray(rgb.transpose(2, 0, 1)))[None]
 
 
 def lpips_distance(model: LPIPS, a: np.ndarray, b: np.ndarray) -> float:

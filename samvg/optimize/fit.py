@@ -1,30 +1,67 @@
-"""Adam on control points and fill colours through the differentiable rasterizer: loss = MSE to
-the target + λ_Xing · Xing loss + λ_LPIPS · LPIPS (the paper's objective).
-"""
+"""Adam on a scene's control points and fill colours through the differentiable rasterizer:
+loss = MSE to the target + λ_Xing · Xing loss + λ_LPIPS · LPIPS (the paper's objective)."""
 
 from __future__ import annotations
 
 import contextlib
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
 
-from samvg.errors import InputError
-from samvg.optimize.losses import xing_loss
+from samvg.config import FitOptions
+from samvg.errors import InputError, SamvgError
+from samvg.optimize.losses import PerceptualLoss, lpips_loss, segment_indices, xing_loss
 from samvg.render import rasterize
+from samvg.scene import Scene
 
-PerceptualLoss = Callable[[torch.Tensor], torch.Tensor]
-"""``loss(rendered)``: a differentiable scalar for an (H, W, 3) render (its target bound inside)."""
+_DIVERGED = "optimization diverged (non-finite coordinates); try a lower learning rate"
+
+StepCallback = Callable[[int, float], None]
+"""``on_step(step, loss)``: called after every Adam step (progress reporting)."""
+
+
+@dataclass(frozen=True)
+class FitSettings:
+    """One optimization phase: Adam ``steps``, learning rates and loss weights.
+
+    ``perceptual`` is a loss bound to the target (see `PerceptualLoss`), weighted by
+    ``perceptual_weight``; None switches that term off.
+    """
+
+    steps: int = 300
+    point_learning_rate: float = 1.0
+    colour_learning_rate: float = 0.01
+    xing_weight: float = 0.0
+    perceptual: PerceptualLoss | None = None
+    perceptual_weight: float = 0.0
+
+    @classmethod
+    def from_options(cls, options: FitOptions, target: np.ndarray | None = None) -> FitSettings:
+        """The settings of ``options``; with ``target`` and LPIPS wanted, the LPIPS loss is
+        loaded and bound to it (raises `WeightsError` when its weights cannot be found)."""
+        perceptual = None
+        if target is not None and options.wants_lpips:
+            perceptual = lpips_loss(target, options.lpips_size, options.lpips_weights)
+        return cls(
+            steps=options.iterations,
+            point_learning_rate=options.point_learning_rate,
+            colour_learning_rate=options.colour_learning_rate,
+            xing_weight=options.xing_weight,
+            perceptual=perceptual,
+            perceptual_weight=options.lpips_weight if perceptual is not None else 0.0,
+        )
+
+    def with_steps(self, steps: int) -> FitSettings:
+        return replace(self, steps=steps)
 
 
 @dataclass
 class FitResult:
-    """Optimised ``points`` (P, 3K, 2), ``colours`` (P, 4) and the total loss after each step."""
+    """The fitted scene and the total loss after each step."""
 
-    points: np.ndarray
-    colours: np.ndarray
+    scene: Scene
     losses: list[float]
 
 
@@ -43,60 +80,69 @@ def single_torch_thread() -> Iterator[None]:
         torch.set_num_threads(threads)
 
 
-def fit_paths(
-    points: np.ndarray,
-    colours: np.ndarray,
-    target: np.ndarray,
-    steps: int = 300,
-    point_learning_rate: float = 1.0,
-    colour_learning_rate: float = 0.01,
-    background: tuple[float, float, float] = (1.0, 1.0, 1.0),
-    on_step: Callable[[int, float], None] | None = None,
-    xing_weight: float = 0.0,
-    lpips: PerceptualLoss | None = None,
-    lpips_weight: float = 0.0,
-) -> FitResult:
-    """Fit paths to ``target`` (H, W, 3) float in [0, 1] for ``steps`` Adam steps.
+def _check_target(target: np.ndarray, scene: Scene) -> torch.Tensor:
+    array = np.asarray(target, dtype=np.float32)
+    if array.ndim != 3 or array.shape[2] != 3:
+        raise InputError(f"target must be an (H, W, 3) image, got shape {array.shape}")
+    if array.shape[:2] != (scene.height, scene.width):
+        raise InputError(
+            f"target is {array.shape[1]}x{array.shape[0]} but the scene is "
+            f"{scene.width}x{scene.height}"
+        )
+    return torch.from_numpy(np.ascontiguousarray(array))
 
-    ``lpips`` is a perceptual loss of the render (see `PerceptualLoss`), weighted by
-    ``lpips_weight``; ``on_step(step, loss)`` is called after every step (progress reporting).
-    Colours are clamped to [0, 1] after every step.
+
+def fit_scene(
+    scene: Scene,
+    target: np.ndarray,
+    settings: FitSettings,
+    on_step: StepCallback | None = None,
+) -> FitResult:
+    """Fit the scene's geometry and flat colours to ``target`` (H, W, 3) float in [0, 1].
+
+    Colours are clamped to [0, 1] after every step; a fit that diverges to non-finite values
+    raises `SamvgError`.
     """
-    target_array = np.asarray(target, dtype=np.float32)
-    if target_array.ndim != 3 or target_array.shape[2] != 3:
-        raise InputError(f"target must be an (H, W, 3) image, got shape {target_array.shape}")
-    height, width = target_array.shape[:2]
-    target_tensor = torch.from_numpy(np.ascontiguousarray(target_array))
-    point_tensor = torch.tensor(points, dtype=torch.float32, requires_grad=True)
-    colour_tensor = torch.tensor(colours, dtype=torch.float32, requires_grad=True)
+    target_tensor = _check_target(target, scene)
+    point_tensor = torch.tensor(scene.points, dtype=torch.float32, requires_grad=True)
+    colour_tensor = torch.tensor(scene.colours(), dtype=torch.float32, requires_grad=True)
     losses: list[float] = []
-    if steps > 0 and len(point_tensor) > 0:
+    if settings.steps > 0 and scene.path_count > 0:
         optimizer = torch.optim.Adam(
             [
-                {"params": [point_tensor], "lr": point_learning_rate},
-                {"params": [colour_tensor], "lr": colour_learning_rate},
+                {"params": [point_tensor], "lr": settings.point_learning_rate},
+                {"params": [colour_tensor], "lr": settings.colour_learning_rate},
             ]
         )
+        indices = segment_indices(scene.offsets)
+        background = scene.background_or_white
         with single_torch_thread():
-            for step in range(steps):
+            for step in range(settings.steps):
                 optimizer.zero_grad(set_to_none=True)
                 rendered = rasterize(
-                    point_tensor, colour_tensor, width, height, background=background
+                    point_tensor,
+                    colour_tensor,
+                    scene.width,
+                    scene.height,
+                    background=background,
+                    offsets=scene.offsets,
                 )
                 loss = torch.mean((rendered - target_tensor) ** 2)
-                if xing_weight > 0:
-                    loss = loss + xing_weight * xing_loss(point_tensor)
-                if lpips is not None and lpips_weight > 0:
-                    loss = loss + lpips_weight * lpips(rendered)
+                if settings.xing_weight > 0:
+                    loss = loss + settings.xing_weight * xing_loss(point_tensor, indices=indices)
+                if settings.perceptual is not None and settings.perceptual_weight > 0:
+                    loss = loss + settings.perceptual_weight * settings.perceptual(rendered)
                 loss.backward()
                 optimizer.step()
                 with torch.no_grad():
                     colour_tensor.clamp_(0.0, 1.0)
+                    if not bool(torch.isfinite(point_tensor).all()):
+                        raise SamvgError(_DIVERGED)
                 losses.append(float(loss.detach()))
                 if on_step is not None:
                     on_step(step, losses[-1])
-    return FitResult(
-        points=point_tensor.detach().numpy().astype(np.float64),
-        colours=colour_tensor.detach().numpy().astype(np.float64),
-        losses=losses,
-    )
+    points = point_tensor.detach().numpy().astype(np.float64)
+    colours = colour_tensor.detach().numpy().astype(np.float64)
+    if not (np.all(np.isfinite(points)) and np.all(np.isfinite(colours))):
+        raise SamvgError(_DIVERGED)
+    return FitResult(scene.with_geometry(points, colours), losses)

@@ -8,6 +8,7 @@ the CPU (diffvg samples edges randomly and needs a C++ build; resvg/Skia are not
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -15,6 +16,7 @@ import torch
 
 from samvg.errors import InputError
 from samvg.render import _kernels as K
+from samvg.scene import Scene
 
 #: Maximum chord error (pixels) of the polyline that replaces each cubic segment.
 FLATTEN_TOLERANCE = 0.05
@@ -65,8 +67,30 @@ def _as_tensor(x: torch.Tensor | np.ndarray, what: str) -> torch.Tensor:
         raise InputError(f"{what} must be a numeric array") from exc
 
 
-def _flat_points(points: _Points) -> tuple[torch.Tensor, np.ndarray]:
+def _packed_points(points: torch.Tensor | np.ndarray, offsets: np.ndarray) -> tuple[
+    torch.Tensor, np.ndarray
+]:
+    """Check packed control points (N, 2) against path offsets (P + 1)."""
+    pts = _as_tensor(points, "points")
+    starts = np.asarray(offsets, dtype=np.int64).reshape(-1)
+    if pts.dim() != 2 or pts.shape[-1] != 2:
+        raise InputError(f"packed points must have shape (N, 2), got {tuple(pts.shape)}")
+    counts = np.diff(starts)
+    if len(starts) < 1 or starts[0] != 0 or starts[-1] != pts.shape[0] or np.any(counts < 3):
+        raise InputError("offsets must rise from 0 to the number of points, 3K points a path")
+    if np.any(counts % 3):
+        raise InputError("every path needs 3K control points")
+    return pts, starts
+
+
+def _flat_points(
+    points: _Points, offsets: np.ndarray | None = None
+) -> tuple[torch.Tensor, np.ndarray]:
     """Return the control points as one (N, 2) tensor and the path start offsets (P + 1)."""
+    if offsets is not None:
+        if not isinstance(points, (torch.Tensor, np.ndarray)):
+            raise InputError("packed points (with offsets) must be one (N, 2) array")
+        return _packed_points(points, offsets)
     if isinstance(points, (torch.Tensor, np.ndarray)):
         pts = _as_tensor(points, "points")
         if pts.dim() != 3 or pts.shape[-1] != 2 or (pts.shape[0] > 0 and pts.shape[1] % 3):
@@ -158,6 +182,7 @@ def rasterize(
     height: int,
     background: Sequence[float] | None = (1.0, 1.0, 1.0),
     *,
+    offsets: np.ndarray | None = None,
     tolerance: float = FLATTEN_TOLERANCE,
 ) -> torch.Tensor:
     """Render closed cubic Bézier paths with exact box-filtered coverage, differentiably.
@@ -166,7 +191,8 @@ def rasterize(
         points: control points in pixel units, either a tensor ``(P, 3K, 2)`` or a sequence of
             ``P`` tensors ``(3K_i, 2)`` (paths with different segment counts). Segment ``k`` of a
             path uses points ``3k, 3k+1, 3k+2`` and ``(3k+3) mod 3K``; every path is closed.
-            Pixel ``(r, c)`` covers ``[c, c+1] x [r, r+1]``.
+            Pixel ``(r, c)`` covers ``[c, c+1] x [r, r+1]``. With ``offsets`` (P + 1 starts),
+            ``points`` is the packed ``(N, 2)`` array of a `samvg.scene.Scene`.
         colors: ``(P, 4)`` straight RGBA in ``[0, 1]`` (used as given, not clamped).
         width, height: canvas size in pixels.
         background: opaque RGB behind the paths; ``None`` means white.
@@ -183,7 +209,7 @@ def rasterize(
     """
     width, height = _check_size(width, height)
     bg = _background(background)
-    flat, starts = _flat_points(points)
+    flat, starts = _flat_points(points, offsets)
     cols = _as_tensor(colors, "colors")
     n_paths = len(starts) - 1
     if cols.dim() != 2 or cols.shape[1] != 4 or cols.shape[0] != n_paths:
@@ -217,9 +243,10 @@ def render_array(
     width: int,
     height: int,
     background: Sequence[float] | None = (1.0, 1.0, 1.0),
+    offsets: np.ndarray | None = None,
 ) -> np.ndarray:
-    """`rasterize` for numpy scenes, without gradients: points (P, 3K, 2) and RGBA (P, 4) to a
-    float32 (height, width, 3) array."""
+    """`rasterize` for numpy scenes, without gradients: points (P, 3K, 2), or packed (N, 2) with
+    ``offsets``, and RGBA (P, 4) to a float32 (height, width, 3) array."""
     with torch.no_grad():
         image = rasterize(
             torch.from_numpy(np.asarray(points)).float(),
@@ -227,8 +254,26 @@ def render_array(
             width,
             height,
             background=background,
+            offsets=offsets,
         )
     return image.numpy().astype(np.float32, copy=False)
+
+
+def render_scene(scene: Scene, scale: float = 1.0) -> np.ndarray:
+    """Render a `Scene` at ``scale`` × its canvas size: float32 (H, W, 3) in [0, 1], no
+    background meaning white."""
+    if not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
+        raise InputError(f"render scale must be a positive number, got {scale}")
+    width = max(1, round(scene.width * scale))
+    height = max(1, round(scene.height * scale))
+    return render_array(
+        scene.points * scale,
+        scene.colours(),
+        width,
+        height,
+        background=scene.background_or_white,
+        offsets=scene.offsets,
+    )
 
 
 def warmup() -> None:

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+import time
 from typing import Any
 
 import numpy as np
 import torch
+from PIL import Image
 
 from samvg.sam.amg_utils import (
     batched_mask_to_box,
@@ -87,14 +89,12 @@ class SamAutomaticMaskGenerator:
         """The whole image's embedding from the last `generate` (reuse it to prompt again)."""
 
     @torch.inference_mode()
-    def generate(self, image) -> list[dict[str, Any]]:
+    def generate(self, image: np.ndarray | Image.Image) -> list[dict[str, Any]]:
         """Masks for an image (H, W, 3) uint8 RGB (other inputs converted, see `to_rgb_uint8`).
 
         Returns a list of dicts with ``segmentation`` (bool H x W), ``area``, ``bbox`` (XYWH),
         ``predicted_iou``, ``point_coords`` ([[x, y]]), ``stability_score``, ``crop_box`` (XYWH).
         """
-        import time
-
         img = to_rgb_uint8(image)
         self.timings = {"encoder": 0.0, "decoder": 0.0, "masks": 0.0, "post": 0.0}
         self.image_embedding = None
@@ -138,8 +138,6 @@ class SamAutomaticMaskGenerator:
     def _process_crop(
         self, img: np.ndarray, crop_box: list[int], layer: int, orig_size: tuple[int, int]
     ) -> dict[str, torch.Tensor]:
-        import time
-
         x0, y0, x1, y1 = crop_box
         crop = img[y0:y1, x0:x1]
         ch, cw = crop.shape[:2]

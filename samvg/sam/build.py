@@ -7,6 +7,7 @@ import pickle
 import zipfile
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import torch
 from torch import nn
@@ -86,7 +87,7 @@ _VIT_CONFIGS = {
 }
 
 
-def _assemble(image_encoder: nn.Module) -> Sam:
+def _assemble(image_encoder: TinyViT | ImageEncoderViT) -> Sam:
     return Sam(
         image_encoder=image_encoder,
         prompt_encoder=PromptEncoder(256, (64, 64), (1024, 1024), 16),
@@ -94,14 +95,14 @@ def _assemble(image_encoder: nn.Module) -> Sam:
     )
 
 
-def build_sam(name: str = "mobile_sam", **encoder_overrides) -> Sam:
+def build_sam(name: str = "mobile_sam", **encoder_overrides: Any) -> Sam:
     """Build an uninitialised model by name (mobile_sam, vit_b, vit_l, vit_h), in eval mode.
 
     ``encoder_overrides`` change the image encoder's config (used by tests to build tiny
     variants); the prompt encoder and mask decoder are always SAM's.
     """
     if name == "mobile_sam":
-        enc: nn.Module = TinyViT(**encoder_overrides)
+        enc: TinyViT | ImageEncoderViT = TinyViT(**encoder_overrides)
     elif name in _VIT_CONFIGS:
         enc = ImageEncoderViT(**{**_VIT_CONFIGS[name], **encoder_overrides})
     else:

@@ -28,11 +28,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import torch
 import torch.nn.functional as F
+from torch import nn
 
 from samvg.sam._kernels import scatter_logits_counts
+from samvg.sam.common import LayerNorm2d
 from samvg.sam.model import Sam
 from samvg.sam.transformer import Attention
 
@@ -98,7 +101,7 @@ class FastDecoder:
     def _precompute(self, emb: torch.Tensor) -> None:
         md, tr = self.md, self.tr
         pe_enc = self.model.prompt_encoder
-        l0, l1 = tr.layers
+        l0, l1 = tr.blocks()
         fa = tr.final_attn_token_to_image
         self.h = h = l0.cross_attn_image_to_token.num_heads
         _, c, gh, gw = emb.shape
@@ -173,16 +176,18 @@ class FastDecoder:
         self.vcf = _lin(b2, fa.v_proj).view(h, 1, -1)
         self.mvf = basis2 @ fa.v_proj.weight.t()
         # output upscaling, first transposed conv as a (C, 4*C/4) matrix, columns (a, b, ch)
-        up = md.output_upscaling
-        w1 = up[0].weight  # (C, C/4, 2, 2)
+        up = md.output_upscaling  # ConvTranspose2d, LayerNorm2d, GELU, ConvTranspose2d, GELU
+        conv1, conv2 = cast(nn.ConvTranspose2d, up[0]), cast(nn.ConvTranspose2d, up[3])
+        assert conv1.bias is not None and conv2.bias is not None  # SAM's have biases
+        w1 = conv1.weight  # (C, C/4, 2, 2)
         self.c4 = w1.shape[1]
         self.wt1 = w1.permute(0, 2, 3, 1).reshape(w1.shape[0], -1)
-        self.bt1 = up[0].bias.repeat(4)
-        self.ln_up = up[1]
-        w2 = up[3].weight  # (C/4, C/8, 2, 2)
+        self.bt1 = conv1.bias.repeat(4)
+        self.ln_up = cast(LayerNorm2d, up[1])
+        w2 = conv2.weight  # (C/4, C/8, 2, 2)
         self.c8 = w2.shape[1]
         self.wt2 = w2.permute(0, 2, 3, 1).reshape(w2.shape[0], -1)
-        self.bt2 = up[3].bias.repeat(4)
+        self.bt2 = conv2.bias.repeat(4)
         self.yt = y2 @ self.wt1  # (N, 4*C/4), scaled by s2*s1 per prompt
         self.ct = b2 @ self.wt1 + self.bt1
         self.mt = basis2 @ self.wt1  # (257, 4*C/4)
@@ -238,7 +243,7 @@ class FastDecoder:
     def transformer(self, sparse: torch.Tensor) -> DecoderState:
         """Run the two-way transformer for B prompts (sparse tokens (B, Ts, C))."""
         md, tr = self.md, self.tr
-        l0, l1 = tr.layers
+        l0, l1 = tr.blocks()
         fa = tr.final_attn_token_to_image
         h = self.h
         b = sparse.shape[0]

@@ -1,11 +1,11 @@
-"""Image preparation for SAM: longest-side resizing (RGB conversion lives in samvg.io)."""
+"""Image preparation for SAM: longest-side resizing (RGB conversion lives in samvg.imaging)."""
 
 from __future__ import annotations
 
 import numpy as np
 from PIL import Image
 
-from samvg.io import to_rgb_uint8
+from samvg.imaging import to_rgb_uint8
 
 __all__ = ["resize_longest_side", "resized_shape", "to_rgb_uint8"]
 

@@ -6,8 +6,10 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from samvg.sam.image_encoder_vit import ImageEncoderViT
 from samvg.sam.mask_decoder import MaskDecoder
 from samvg.sam.prompt_encoder import PromptEncoder
+from samvg.sam.tiny_vit import TinyViT
 
 PIXEL_MEAN = (123.675, 116.28, 103.53)
 PIXEL_STD = (58.395, 57.12, 57.375)
@@ -17,9 +19,14 @@ class Sam(nn.Module):
     """Segment Anything: ``image_encoder``, ``prompt_encoder``, ``mask_decoder``."""
 
     mask_threshold: float = 0.0
+    pixel_mean: torch.Tensor
+    pixel_std: torch.Tensor
 
     def __init__(
-        self, image_encoder: nn.Module, prompt_encoder: PromptEncoder, mask_decoder: MaskDecoder
+        self,
+        image_encoder: TinyViT | ImageEncoderViT,
+        prompt_encoder: PromptEncoder,
+        mask_decoder: MaskDecoder,
     ) -> None:
         super().__init__()
         self.image_encoder = image_encoder

@@ -5,7 +5,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import numpy.typing as npt
 import torch
+from PIL import Image
 
 from samvg.errors import InputError
 from samvg.sam.fast_decoder import FastDecoder
@@ -30,7 +32,7 @@ def resize_logits(
     img_size = 4 * grid
     h_av, w_av = logits.shape[-2:]
 
-    def axis(n_out: int, n_in: int, avail: int):
+    def axis(n_out: int, n_in: int, avail: int) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         pos = (torch.arange(n_out, dtype=torch.float32, device=logits.device) + 0.5) * (
             n_in / n_out
         ) * (grid / img_size) - 0.5
@@ -55,7 +57,7 @@ def needed_lowres(input_size: tuple[int, int], grid: int = 256) -> tuple[int, in
     )
 
 
-def _as_float_array(x, shape_tail: tuple[int, ...], what: str) -> np.ndarray:
+def _as_float_array(x: npt.ArrayLike, shape_tail: tuple[int, ...], what: str) -> np.ndarray:
     arr = np.asarray(x, dtype=np.float64)
     if arr.ndim != len(shape_tail) + 1 or arr.shape[1:] != shape_tail:
         raise InputError(
@@ -90,7 +92,7 @@ class SamPredictor:
         return self.features is not None
 
     @torch.inference_mode()
-    def set_image(self, image, image_format: str = "RGB") -> None:
+    def set_image(self, image: np.ndarray | Image.Image, image_format: str = "RGB") -> None:
         """Encode an image: (H, W, 3) uint8 RGB (others are converted, see `to_rgb_uint8`)."""
         img = to_rgb_uint8(image)
         if image_format.upper() == "BGR":

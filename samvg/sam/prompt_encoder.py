@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import torch
 from torch import nn
@@ -12,6 +13,8 @@ from samvg.sam.common import LayerNorm2d
 
 class PositionEmbeddingRandom(nn.Module):
     """Fourier features of normalised (x, y) coordinates with a fixed random Gaussian matrix."""
+
+    positional_encoding_gaussian_matrix: torch.Tensor
 
     def __init__(self, num_pos_feats: int = 64) -> None:
         super().__init__()
@@ -73,6 +76,10 @@ class PromptEncoder(nn.Module):
         """Positional encoding of the image embedding grid: (1, C, 64, 64)."""
         return self.pe_layer(self.image_embedding_size).unsqueeze(0)
 
+    def _point_embedding(self, index: int) -> torch.Tensor:
+        """(1, C) embedding of point label ``index`` (0/1: negative/positive, 2/3: box corners)."""
+        return cast(nn.Embedding, self.point_embeddings[index]).weight
+
     def _embed_points(self, points: torch.Tensor, labels: torch.Tensor, pad: bool) -> torch.Tensor:
         points = points + 0.5  # pixel centres
         if pad:
@@ -85,15 +92,15 @@ class PromptEncoder(nn.Module):
         lab = labels[..., None]
         emb = torch.where(lab == -1, torch.zeros_like(emb), emb)
         emb = emb + (lab == -1) * self.not_a_point_embed.weight
-        emb = emb + (lab == 0) * self.point_embeddings[0].weight
-        emb = emb + (lab == 1) * self.point_embeddings[1].weight
+        emb = emb + (lab == 0) * self._point_embedding(0)
+        emb = emb + (lab == 1) * self._point_embedding(1)
         return emb
 
     def _embed_boxes(self, boxes: torch.Tensor) -> torch.Tensor:
         coords = (boxes + 0.5).reshape(-1, 2, 2)
         emb = self.pe_layer.forward_with_coords(coords, self.input_image_size)
-        emb[:, 0, :] += self.point_embeddings[2].weight[0]
-        emb[:, 1, :] += self.point_embeddings[3].weight[0]
+        emb[:, 0, :] += self._point_embedding(2)[0]
+        emb[:, 1, :] += self._point_embedding(3)[0]
         return emb
 
     def forward(

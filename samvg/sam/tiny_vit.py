@@ -116,6 +116,8 @@ class Attention(nn.Module):
     microseconds); nothing is cached on ``eval()``, so loading weights at any time is safe.
     """
 
+    attention_bias_idxs: torch.Tensor
+
     def __init__(self, dim: int, key_dim: int, num_heads: int, window: int) -> None:
         super().__init__()
         self.num_heads = num_heads

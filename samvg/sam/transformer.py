@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import cast
+
 import torch
 from torch import nn
 
@@ -111,6 +113,10 @@ class TwoWayTransformer(nn.Module):
             embedding_dim, num_heads, attention_downsample_rate
         )
         self.norm_final_attn = nn.LayerNorm(embedding_dim)
+
+    def blocks(self) -> list[TwoWayAttentionBlock]:
+        """The ``depth`` blocks of ``layers``, typed (a ModuleList yields plain modules)."""
+        return [cast(TwoWayAttentionBlock, layer) for layer in self.layers]
 
     def forward(
         self, image_embedding: torch.Tensor, image_pe: torch.Tensor, point_embedding: torch.Tensor

@@ -1,36 +1,20 @@
-"""Stage 1 and the SAM half of stage 4: which masks become paths."""
+"""Stage 1: which SAM masks become paths (automatic masks, filter by impact, re-prompts)."""
 
-from samvg.segment.components import all_components, split_components
-from samvg.segment.impact import ImpactCanvas, filter_by_impact, keep_all
-from samvg.segment.masks import (
-    MaskSelection,
-    Segmenter,
-    min_component_pixels,
-    missing_masks,
-    select_masks,
-)
-from samvg.segment.prompts import (
-    circular_kernel,
-    error_map,
-    missing_component_map,
-    missing_component_prompts,
-    uncovered_prompts,
-)
+from samvg.segment.impact import ImpactCanvas, filter_by_impact, keep_all, offer_best
+from samvg.segment.prompts import circular_kernel, disc_sum, uncovered_prompts
+from samvg.segment.segmenter import Segmenter
+from samvg.segment.select import MaskSelection, SegmentSettings, select_masks
 
 __all__ = [
-    "all_components",
-    "min_component_pixels",
-    "split_components",
     "ImpactCanvas",
     "MaskSelection",
+    "SegmentSettings",
     "Segmenter",
     "circular_kernel",
-    "error_map",
+    "disc_sum",
     "filter_by_impact",
     "keep_all",
-    "missing_component_map",
-    "missing_component_prompts",
-    "missing_masks",
+    "offer_best",
     "select_masks",
     "uncovered_prompts",
 ]

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from samvg.errors import InputError
+from samvg.imaging import filled_components
 
 
 @dataclass
@@ -148,3 +149,28 @@ def keep_all(
     order = sorted(range(len(masks)), key=lambda i: -int(np.count_nonzero(masks[i])))
     kept = [i for i in order if canvas.offer(masks[i], keep=bool(masks[i].any())).kept]
     return kept, canvas
+
+
+def offer_best(
+    canvas: ImpactCanvas,
+    candidates: list[list[np.ndarray]],
+    min_pixels: float,
+    use_filter: bool = True,
+    below: bool = False,
+) -> int:
+    """Per prompt, take SAM's candidate mask with the largest impact (with the filter off: SAM's
+    first candidate) and offer its components to ``canvas``, prompts in the order given
+    (largest region first). Returns how many components were kept."""
+    kept = 0
+    for options in candidates:
+        if not options:
+            continue
+        if use_filter:
+            impacts = [canvas.impact_of(mask, below)[0] for mask in options]
+            best = options[int(np.argmax(impacts))]
+        else:
+            best = options[0]
+        for part in filled_components(best, min_pixels):
+            forced = None if use_filter else True
+            kept += canvas.offer(part, below=below, keep=forced).kept
+    return kept

@@ -7,7 +7,6 @@ from samvg.trace.tracer import (
     DEFAULT_MIN_AREA,
     TracedPath,
     trace_components,
-    trace_mask,
     trace_masks,
     trace_masks_with_info,
 )
@@ -20,7 +19,6 @@ __all__ = [
     "mask_contour",
     "select_corners",
     "trace_components",
-    "trace_mask",
     "trace_masks",
     "trace_masks_with_info",
 ]

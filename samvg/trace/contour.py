@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
-from scipy import ndimage
 
 from samvg.errors import InputError
+from samvg.imaging import label_components
 
 # Directions E, S, W, N as (dx, dy) with y pointing down; turning right is d + 1 (mod 4).
 _DX = np.array([1, 0, -1, 0], dtype=np.int64)
@@ -91,43 +91,23 @@ class Components:
 
 def find_components(mask: np.ndarray, min_area: float = 1) -> Components:
     """Components of a boolean (H, W) mask with at least ``min_area`` pixels, largest first."""
-    binary = np.asarray(mask)
-    if binary.ndim != 2:
-        raise InputError(f"mask must be two-dimensional, got shape {binary.shape}")
-    binary = binary.astype(bool, copy=False)
-    rows = np.flatnonzero(binary.any(axis=1))
-    empty = np.zeros(0, dtype=np.int64)
-    if len(rows) == 0:
-        return Components(np.zeros((2, 2), np.int32), (-1, -1), empty, empty, [], [])
-    cols = np.flatnonzero(binary.any(axis=0))
-    crop = binary[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]
-    labels, count = ndimage.label(np.pad(crop, 1))
-    origin = (int(rows[0]) - 1, int(cols[0]) - 1)
-    if count == 1:  # the common case: skip counting and boxing, the crop is the box
-        areas = np.array([0, int(np.count_nonzero(crop))])
-        boxes = [(slice(1, crop.shape[0] + 1), slice(1, crop.shape[1] + 1))]
-    else:
-        areas = np.bincount(labels.ravel(), minlength=count + 1)
-        boxes = ndimage.find_objects(labels)
-    ids = np.flatnonzero(areas >= max(min_area, 1))
-    ids = ids[ids > 0]
+    found = label_components(mask, min_area)
+    labels, origin, ids = found.labels, found.origin, found.ids
     if len(ids) == 0:
-        return Components(labels, origin, empty, empty, [], [])
-    ids = ids[np.argsort(-areas[ids], kind="stable")]
-    kept_boxes = [boxes[label - 1] for label in ids]
+        return Components(labels, origin, ids, found.areas, [], [])
     contours = []
-    for label, (rows_slice, cols_slice) in zip(ids, kept_boxes, strict=True):
+    for label, area, (rows_slice, cols_slice) in zip(ids, found.areas, found.boxes, strict=True):
         # The top edge of the component's first pixel in raster order is on its outer boundary.
         row = rows_slice.start
         col = cols_slice.start + int(np.argmax(labels[row, cols_slice] == label))
         contour = _follow_boundary(
-            labels, int(label), row, col, 4 * int(areas[label]) + 4,
+            labels, int(label), row, col, 4 * int(area) + 4,
             _DX, _DY, _AHEAD_RIGHT, _AHEAD_LEFT,
         )  # fmt: skip
         contour[:, 0] += origin[1]
         contour[:, 1] += origin[0]
         contours.append(contour)
-    return Components(labels, origin, ids, areas[ids], kept_boxes, contours)
+    return Components(labels, origin, ids, found.areas, found.boxes, contours)
 
 
 def mask_contour(mask: np.ndarray) -> np.ndarray:

@@ -7,12 +7,11 @@ Bézier, fitted by least squares with Newton reparameterization and pinned to th
 
 Public API:
 
-* ``trace_masks(masks, image, segments_per_path=4, min_area=16) -> VectorImage``: the paths,
-  filled with the mean colour of the image under each component, in paint order.
-* ``trace_masks_with_info(...) -> (VectorImage, list[TracedPath])``: the same image and, for each
-  of its paths (same order), the source mask index, component area and fitting error.
+* ``trace_masks(masks, image, segments_per_path=4, min_area=16) -> Scene``: the paths, filled
+  with the mean colour of the image under each component, in paint order.
+* ``trace_masks_with_info(...) -> (Scene, list[TracedPath])``: the same scene and, for each of
+  its paths (same order), the source mask index, component area and fitting error.
 * ``trace_components(mask, segments=4, min_area=16) -> list[TracedPath]``: geometry only.
-* ``trace_mask(mask, num_segments=5) -> (3K, 2) points``: the largest component only.
 """
 
 from __future__ import annotations
@@ -23,10 +22,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from samvg.errors import InputError
+from samvg.imaging import to_float_rgb
+from samvg.scene import FlatPaint, Scene
 from samvg.trace.contour import Components, find_components
 from samvg.trace.corners import select_corners
 from samvg.trace.fit import fit_cubics
-from samvg.vector_image import VectorImage, VectorPath
 
 #: Default smallest component kept, in pixels (a 4 × 4 block): smaller specks would cost a whole
 #: path of 3K control points for almost no pixels, and a few-pixel contour cannot carry K cubics.
@@ -40,8 +40,8 @@ MAX_FIT_POINTS = 64
 class TracedPath:
     """One traced component.
 
-    ``points`` (3K, 2): the closed path in :class:`~samvg.vector_image.VectorPath` layout, starting
-    at a corner. ``mask_index``: index of the source mask. ``area``: pixel count of the component
+    ``points`` (3K, 2): the closed path in :class:`~samvg.scene.Scene` layout, starting at a
+    corner. ``mask_index``: index of the source mask. ``area``: pixel count of the component
     (holes not counted). ``max_error`` / ``rms_error``: max and RMS distance in pixels between the
     contour points and the fitted curve (each point to its Newton-refined parameter's point).
     """
@@ -110,13 +110,9 @@ def _as_rgb(image: object) -> np.ndarray:
     array = np.asarray(image)
     if array.ndim != 3 or array.shape[2] != 3 or array.shape[0] < 1 or array.shape[1] < 1:
         raise InputError(f"image must be RGB with shape (H, W, 3), got shape {array.shape}")
-    if array.dtype == np.uint8:
-        return array.astype(np.float32) / np.float32(255.0)
-    if array.dtype.kind != "f":
+    if array.dtype != np.uint8 and array.dtype.kind != "f":
         raise InputError(f"image must be uint8 or float in [0, 1], got dtype {array.dtype}")
-    if not np.all(np.isfinite(array)) or array.min() < 0.0 or array.max() > 1.0:
-        raise InputError("float image values must be finite and in [0, 1]")
-    return array.astype(np.float32)
+    return to_float_rgb(array)
 
 
 def _densify(contour: np.ndarray, minimum: int) -> np.ndarray:
@@ -215,8 +211,8 @@ def trace_masks_with_info(
     image: np.ndarray,
     segments_per_path: int = 4,
     min_area: float = DEFAULT_MIN_AREA,
-) -> tuple[VectorImage, list[TracedPath]]:
-    """:func:`trace_masks`, plus one :class:`TracedPath` per path of the image, in the same order
+) -> tuple[Scene, list[TracedPath]]:
+    """:func:`trace_masks`, plus one :class:`TracedPath` per path of the scene, in the same order
     (source mask index, component area, fitting error)."""
     segments = _check_count(segments_per_path, "segments_per_path")
     min_area = _check_min_area(min_area)
@@ -226,10 +222,10 @@ def trace_masks_with_info(
     traced, found = _trace(binary, segments, min_area)
     colours = [colour for components in found for colour in _mean_colours(components, rgb)]
     paths = [
-        VectorPath(path.points, (*colour, 1.0))
+        (path.points, FlatPaint((*colour, 1.0)))
         for path, colour in zip(traced, colours, strict=True)
     ]
-    return VectorImage(width, height, paths), traced
+    return Scene.from_paths(width, height, paths), traced
 
 
 def trace_masks(
@@ -237,10 +233,10 @@ def trace_masks(
     image: np.ndarray,
     segments_per_path: int = 4,
     min_area: float = DEFAULT_MIN_AREA,
-) -> VectorImage:
+) -> Scene:
     """Trace boolean masks (a list of (H, W) arrays or an (N, H, W) array, in paint order) over
-    an RGB ``image`` (H, W, 3; uint8, or float in [0, 1]) into a :class:`VectorImage` without a
-    background.
+    an RGB ``image`` (H, W, 3; uint8, or float in [0, 1]) into a :class:`~samvg.scene.Scene`
+    without a background.
 
     Every connected component (4-connected) of every mask with at least ``min_area`` pixels
     becomes one closed path of ``segments_per_path`` cubic segments with its holes filled (masks
@@ -250,21 +246,3 @@ def trace_masks(
     masks that are not (H, W) or differ in size from the image raise :class:`InputError`.
     """
     return trace_masks_with_info(masks, image, segments_per_path, min_area)[0]
-
-
-def trace_mask(mask: np.ndarray, num_segments: int = 5) -> np.ndarray:
-    """Trace the largest component of a mask (holes filled) into ``num_segments`` cubics:
-    (3K, 2) points in :class:`~samvg.vector_image.VectorPath` layout. Any non-zero value counts
-    as inside; an empty mask raises :class:`InputError`."""
-    num_segments = _check_count(num_segments, "num_segments")
-    binary = np.asarray(mask)
-    if binary.ndim != 2:
-        raise InputError(f"mask must be two-dimensional, got shape {binary.shape}")
-    components = find_components(binary.astype(bool, copy=False))
-    if not components.contours:
-        raise InputError("mask is empty: nothing to trace")
-    largest = components.contours[0]
-    contour = _densify(largest, 4 * num_segments)
-    indices, sizes = _stretches(contour, num_segments)
-    fits = fit_cubics(contour[indices], np.concatenate([[0], np.cumsum(sizes)]))
-    return fits.controls[:, :3, :].reshape(3 * num_segments, 2)

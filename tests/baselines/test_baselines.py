@@ -19,7 +19,9 @@ from samvg.baselines import (
     schedule,
     vtracer_trace,
 )
-from samvg.baselines.live import error_map, find_seeds
+from samvg.baselines.live import find_seeds
+from samvg.imaging import error_map
+from samvg.optimize import FitSettings
 
 
 def load(bench_dir: Path, relative: str, side: int) -> np.ndarray:
@@ -61,8 +63,8 @@ def test_random_init_is_deterministic_and_fitting_lowers_the_error(cactus):
     start = random_init(cactus, 8, steps=0, seed=5)
     fitted = random_init(cactus, 8, steps=60, seed=5)
     repeat = random_init(cactus, 8, steps=60, seed=5)
-    assert len(fitted.paths) == 8 and (fitted.width, fitted.height) == (64, 64)
-    np.testing.assert_array_equal(fitted.stacked_paths()[0], repeat.stacked_paths()[0])
+    assert fitted.path_count == 8 and (fitted.width, fitted.height) == (64, 64)
+    np.testing.assert_array_equal(fitted.points, repeat.points)
     before, after = mse(start.render(), cactus), mse(fitted.render(), cactus)
     assert after < 0.6 * before, (before, after)
 
@@ -83,7 +85,7 @@ def two_squares() -> np.ndarray:
 
 def test_seeds_go_to_the_largest_regions_of_error_with_their_colour():
     target = two_squares()
-    error = error_map(np.ones_like(target), target)
+    error = error_map(target, np.ones_like(target))
     first, second = find_seeds(error, target, 2)
     assert 8 < first.centre[0] < 40 and 8 < first.centre[1] < 40
     np.testing.assert_allclose(first.colour, (0.9, 0.1, 0.1), atol=1e-4)
@@ -100,7 +102,7 @@ def test_live_adds_paths_where_the_error_is():
     # of the red square (the largest error region), one in the blue square
     result = live(target, 3, steps=0)
     render = result.render()
-    assert len(result.paths) == 3
+    assert result.path_count == 3
     np.testing.assert_allclose(render[24, 24], (0.9, 0.1, 0.1), atol=0.02)
     np.testing.assert_allclose(render[53, 49], (0.1, 0.2, 0.8), atol=0.02)
     assert np.allclose(render[4, 60], 1.0)  # nothing placed where there was no error
@@ -109,7 +111,7 @@ def test_live_adds_paths_where_the_error_is():
 def test_live_fits_a_real_image(cactus):
     calls = []
     result = live(cactus, 6, steps=40, progress=lambda done, total: calls.append((done, total)))
-    assert len(result.paths) == 6
+    assert result.path_count == 6
     assert calls[-1] == (40, 40) and len(calls) == 40
     assert mse(result.render(), cactus) < 0.5 * mse(np.ones_like(cactus), cactus)
 
@@ -128,7 +130,7 @@ def test_vtracer_path_count_lands_near_the_target(bench_dir):
 
 
 def test_run_baseline_gives_one_shape_for_every_method(cactus):
-    options = {"steps": 5, "point_learning_rate": 1.0, "colour_learning_rate": 0.01}
+    options = FitSettings(steps=5, point_learning_rate=1.0, colour_learning_rate=0.01)
     for name in ("diffvg", "live", "vtracer"):
         result = run_baseline(name, (cactus * 255).astype(np.uint8), 4, options, seed=1)
         assert result.render().shape == (64, 64, 3)
@@ -140,9 +142,9 @@ def test_run_baseline_gives_one_shape_for_every_method(cactus):
 
 def test_run_baseline_rejects_bad_requests(cactus):
     with pytest.raises(InputError, match="unknown baseline"):
-        run_baseline("potrace", cactus, 4, {"steps": 1})
+        run_baseline("potrace", cactus, 4, FitSettings(steps=1))
     with pytest.raises(InputError, match="path count"):
-        run_baseline("diffvg", cactus, 0, {"steps": 1})
+        run_baseline("diffvg", cactus, 0, FitSettings(steps=1))
     with pytest.raises(InputError, match="steps"):
         run_baseline("live", cactus, 3)
     with pytest.raises(InputError, match="steps"):

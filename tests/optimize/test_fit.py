@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from samvg import InputError, VectorImage, VectorPath
-from samvg.optimize import fit_paths
+from samvg import InputError, SamvgError
+from samvg.optimize import FitSettings, fit_scene
+from samvg.scene import FlatPaint, Scene
 
 
 def square(x0: float, y0: float, size: float) -> np.ndarray:
@@ -16,20 +17,41 @@ def square(x0: float, y0: float, size: float) -> np.ndarray:
     return np.array(points)
 
 
+def scene_of(paths, size=64) -> Scene:
+    return Scene.from_paths(size, size, [(points, FlatPaint(fill)) for points, fill in paths])
+
+
 def test_fit_moves_shape_and_colour_onto_target():
-    truth = VectorImage(64, 64, [VectorPath(square(20, 24, 24), (0.9, 0.2, 0.1, 1.0))])
-    target = truth.render()
-    start_points = square(14, 18, 20)[None]
-    result = fit_paths(start_points, np.array([[0.5, 0.5, 0.5, 1.0]]), target, steps=150)
+    target = scene_of([(square(20, 24, 24), (0.9, 0.2, 0.1, 1.0))]).render()
+    start = scene_of([(square(14, 18, 20), (0.5, 0.5, 0.5, 1.0))])
+    result = fit_scene(start, target, FitSettings(steps=150))
     assert result.losses[-1] < result.losses[0] / 20
-    np.testing.assert_allclose(result.colours[0, :3], (0.9, 0.2, 0.1), atol=0.05)
-    fitted = VectorImage(64, 64, [VectorPath(result.points[0], tuple(result.colours[0]))])
-    assert np.abs(fitted.render() - target).mean() < 0.01
-    assert np.abs(result.points[0, 6] - (44, 48)).max() < 1.0  # the far corner found its place
+    np.testing.assert_allclose(result.scene.colours()[0, :3], (0.9, 0.2, 0.1), atol=0.05)
+    assert np.abs(result.scene.render() - target).mean() < 0.01
+    assert np.abs(result.scene.points[6] - (44, 48)).max() < 1.0  # the far corner found its place
+
+
+def test_fit_handles_paths_of_different_lengths():
+    triangle = square(30, 30, 20)[:9]  # three of the square's segments, closed
+    target = scene_of([(square(8, 8, 16), (0.1, 0.6, 0.2, 1.0)), (triangle, (0, 0, 1, 1))])
+    start = scene_of([(square(10, 10, 12), (0.5, 0.5, 0.5, 1.0)), (triangle + 3, (0, 0, 1, 1))])
+    settings = FitSettings(steps=120, xing_weight=0.01)
+    result = fit_scene(start, target.render(), settings)
+    assert list(result.scene.segment_counts()) == [4, 3]
+    assert result.losses[-1] < result.losses[0] / 10
 
 
 def test_fit_rejects_bad_target_and_accepts_no_paths():
+    one = scene_of([(square(1, 1, 4), (0, 0, 0, 1))], size=8)
     with pytest.raises(InputError, match="target"):
-        fit_paths(np.zeros((1, 3, 2)), np.ones((1, 4)), np.zeros((8, 8)))
-    empty = fit_paths(np.zeros((0, 3, 2)), np.zeros((0, 4)), np.zeros((8, 8, 3)), steps=5)
-    assert empty.points.shape == (0, 3, 2) and empty.losses == []
+        fit_scene(one, np.zeros((8, 8)), FitSettings())
+    with pytest.raises(InputError, match="scene is 8x8"):
+        fit_scene(one, np.zeros((9, 8, 3)), FitSettings())
+    empty = fit_scene(Scene(8, 8), np.zeros((8, 8, 3)), FitSettings(steps=5))
+    assert empty.scene.path_count == 0 and empty.losses == []
+
+
+def test_diverging_fit_is_a_clear_error():
+    one = scene_of([(square(1, 1, 4), (0, 0, 0, 1))], size=8)
+    with pytest.raises(SamvgError, match="diverged"):
+        fit_scene(one, np.zeros((8, 8, 3)), FitSettings(steps=3, point_learning_rate=float("inf")))

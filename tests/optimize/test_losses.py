@@ -1,6 +1,7 @@
 """Xing loss: zero for well-formed segments, positive for crossing handles, differentiable."""
 
 import numpy as np
+import pytest
 import torch
 
 from samvg.optimize.losses import xing_loss
@@ -36,3 +37,17 @@ def test_crossing_handles_are_penalised_with_gradient():
 
 def test_empty_scene():
     assert float(xing_loss(torch.zeros((0, 12, 2)))) == 0.0
+
+
+def test_packed_paths_of_different_lengths_match_the_equal_length_form():
+    from samvg.optimize.losses import segment_indices
+
+    circle = circle_path(4).clone()
+    circle[0, 1], circle[0, 2] = circle[0, 2].clone(), circle[0, 1].clone()
+    triangle = circle_path(3)
+    packed = torch.cat([circle[0], triangle[0]])
+    offsets = np.array([0, 12, 21])
+    start, first, second, end = segment_indices(offsets)
+    assert end.tolist() == [3, 6, 9, 0, 15, 18, 12]
+    expected = (xing_loss(circle) * 4 + xing_loss(triangle) * 3) / 7
+    assert float(xing_loss(packed, offsets)) == pytest.approx(float(expected), rel=1e-6)

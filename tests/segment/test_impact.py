@@ -83,17 +83,3 @@ def test_bad_shapes_are_errors():
     with pytest.raises(ValueError, match="does not match"):
         canvas.offer(np.ones((5, 5), bool))
     assert not canvas.offer(np.zeros((10, 10), bool)).kept
-
-
-def test_components_are_split_filled_and_tiny_ones_dropped():
-    from samvg.segment import split_components
-
-    mask = np.zeros((30, 40), bool)
-    mask[2:12, 2:12] = True
-    mask[5:8, 5:8] = False  # a hole: filled
-    mask[20:28, 20:36] = True  # the larger component
-    mask[0, 39] = True  # a speck: dropped
-    parts = split_components(mask, min_pixels=4)
-    assert [int(p.sum()) for p in parts] == [128, 100]
-    assert parts[1][6, 6] and not (parts[0] & parts[1]).any()
-    assert split_components(np.zeros((5, 5), bool), 1) == []

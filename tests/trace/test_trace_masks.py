@@ -11,6 +11,7 @@ from PIL import Image
 from scipy import ndimage
 
 from samvg.errors import InputError
+from samvg.scene import Scene
 from samvg.trace import (
     DEFAULT_MIN_AREA,
     fit_cubics,
@@ -20,7 +21,8 @@ from samvg.trace import (
     trace_masks,
     trace_masks_with_info,
 )
-from samvg.trace.synthetic import (
+from samvg.vector_image import VectorImage
+from tests.trace.synthetic import (
     blob,
     disk,
     ellipse,
@@ -31,7 +33,6 @@ from samvg.trace.synthetic import (
     rounded_rectangle,
     star,
 )
-from samvg.vector_image import VectorImage
 
 SMOOTH = {
     "disk": disk(),
@@ -66,7 +67,8 @@ def test_smooth_shapes_at_four_segments(name):
 def test_resvg_agrees_with_the_project_rasterizer():
     mask = blob()
     image = trace_masks([mask], np.zeros((128, 128, 3), np.uint8))
-    png = resvg_py.svg_to_bytes(svg_string=image.to_svg(precision=3), background="#ffffff")
+    svg = VectorImage.from_scene(image).to_svg(precision=3)
+    png = resvg_py.svg_to_bytes(svg_string=svg, background="#ffffff")
     coverage = 1.0 - np.asarray(Image.open(io.BytesIO(bytes(png))).convert("L"), float) / 255.0
     assert iou(coverage, mask) >= 0.97
     assert iou(coverage, mask) == pytest.approx(traced_iou(mask, 4), abs=0.005)
@@ -184,8 +186,9 @@ def test_trace_masks_paints_in_order_with_mean_colours():
     left = np.zeros((64, 64), bool)
     left[10:50, 8:30] = True
     empty = np.zeros((64, 64), bool)
-    result, info = trace_masks_with_info([background, empty, left], image)
-    assert isinstance(result, VectorImage) and (result.width, result.height) == (64, 64)
+    scene, info = trace_masks_with_info([background, empty, left], image)
+    assert isinstance(scene, Scene) and (scene.width, scene.height) == (64, 64)
+    result = VectorImage.from_scene(scene)
     assert result.background is None
     assert [p.mask_index for p in info] == [0, 2]
     assert [p.area for p in info] == [56 * 56, 40 * 22]
@@ -194,7 +197,9 @@ def test_trace_masks_paints_in_order_with_mean_colours():
     assert result.paths[1].fill == pytest.approx((200 / 255, 40 / 255, 0.0, 1.0), abs=1e-5)
     for path, traced in zip(result.paths, info, strict=True):
         np.testing.assert_array_equal(path.points, traced.points)
-    as_float = trace_masks(np.stack([background, empty, left]), image / 255.0)
+    as_float = VectorImage.from_scene(
+        trace_masks(np.stack([background, empty, left]), image / 255.0)
+    )
     for a, b in zip(as_float.paths, result.paths, strict=True):
         np.testing.assert_allclose(a.points, b.points)
         assert a.fill == pytest.approx(b.fill, abs=1e-5)
@@ -207,8 +212,8 @@ def test_masks_of_zeros_and_ones_are_accepted():
     reference = trace_masks([mask], np.zeros((64, 64, 3)))
     for dtype in (np.uint8, np.int64, np.float32, np.float64):
         other = trace_masks([mask.astype(dtype)], np.zeros((64, 64, 3)))
-        np.testing.assert_array_equal(other.paths[0].points, reference.paths[0].points)
-    assert trace_masks([], np.zeros((8, 8, 3))).paths == []
+        np.testing.assert_array_equal(other.points, reference.points)
+    assert trace_masks([], np.zeros((8, 8, 3))).path_count == 0
 
 
 def test_fitting_error_is_reported():
@@ -271,7 +276,7 @@ def test_hundred_masks_at_512_px_are_fast():
     start = time.process_time()
     result = trace_masks(masks, image)
     elapsed = time.process_time() - start
-    assert len(result.paths) == 100
+    assert result.path_count == 100
     assert elapsed < 2.0  # typically ~0.2 s; generous for a shared machine
 
 

@@ -1,0 +1,249 @@
+"""The scene: the one type every stage takes and returns.
+
+Closed cubic Bézier paths, each with its own number of segments and its own paint, over an
+optional opaque background, in *working* pixels (the canvas the pipeline computes on), with the
+frame that maps them back to the input image held once.
+
+Geometry is packed for the numba kernels and for Adam: ``points`` is one (N, 2) float64 array
+of every path's control points in paint order (bottom first) and ``offsets`` (P + 1) marks where
+each path starts. A path with K segments owns 3K points; segment k runs from ``p[3k]`` through
+``p[3k+1]`` and ``p[3k+2]`` to ``p[(3k+3) % 3K]``, so the last segment returns to the first
+point. Pixel (row r, column c) is the square [c, c+1] × [r, r+1].
+
+Paints are immutable values, one per path. Only flat RGBA fills exist today; gradient paints
+will join :data:`Paint` without changing the packing of the geometry.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from samvg.errors import InputError
+
+RGB = tuple[float, float, float]
+RGBA = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class FlatPaint:
+    """A solid fill: straight (non-premultiplied) RGBA in [0, 1], nonzero fill rule."""
+
+    rgba: RGBA
+
+    def __post_init__(self) -> None:
+        values = tuple(float(value) for value in self.rgba)
+        if len(values) == 3:
+            values = (*values, 1.0)
+        if len(values) != 4 or not all(math.isfinite(v) and 0.0 <= v <= 1.0 for v in values):
+            raise InputError(f"fill must be RGBA values in [0, 1], got {self.rgba}")
+        object.__setattr__(self, "rgba", values)
+
+    @property
+    def parameter_count(self) -> int:
+        return 4
+
+    @property
+    def opaque(self) -> bool:
+        return self.rgba[3] >= 1.0
+
+
+Paint = FlatPaint
+"""Every paint a path can have (linear and radial gradients will join this union)."""
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Where the working canvas sits in the input image: input pixels = working pixels / scale,
+    on an input canvas of ``width`` × ``height`` pixels."""
+
+    width: int
+    height: int
+    scale: float = 1.0
+
+
+def _check_background(background: Sequence[float] | None) -> RGB | None:
+    if background is None:
+        return None
+    values = tuple(float(v) for v in background)
+    if len(values) != 3 or not all(math.isfinite(v) and 0.0 <= v <= 1.0 for v in values):
+        raise InputError(f"background must be RGB values in [0, 1], got {background}")
+    return (values[0], values[1], values[2])
+
+
+def _check_canvas(value: object, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InputError(f"canvas {name} must be a positive integer, got {value!r}")
+    return int(value)
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """Paths with paints on a ``width`` × ``height`` canvas (see the module docstring)."""
+
+    width: int
+    height: int
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
+    paints: tuple[Paint, ...] = ()
+    background: RGB | None = None
+    frame: Frame | None = None
+    """The input canvas; None when the scene is already in input pixels."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "width", _check_canvas(self.width, "width"))
+        object.__setattr__(self, "height", _check_canvas(self.height, "height"))
+        points = np.ascontiguousarray(self.points, dtype=np.float64)
+        offsets = np.asarray(self.offsets, dtype=np.int64)
+        if points.ndim != 2 or points.shape[1] != 2:
+            raise InputError(f"scene points must have shape (N, 2), got {points.shape}")
+        if offsets.ndim != 1 or len(offsets) < 1 or offsets[0] != 0 or offsets[-1] != len(points):
+            raise InputError("scene offsets must run from 0 to the number of points")
+        counts = np.diff(offsets)
+        if np.any(counts < 3) or np.any(counts % 3):
+            raise InputError("every path needs 3K control points with K >= 1")
+        if len(self.paints) != len(counts):
+            raise InputError(f"{len(counts)} paths but {len(self.paints)} paints")
+        if not np.all(np.isfinite(points)):
+            bad = int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])
+            path = int(np.searchsorted(offsets, bad, side="right") - 1)
+            raise InputError(f"path {path} has non-finite coordinates")
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "offsets", offsets)
+        object.__setattr__(self, "paints", tuple(self.paints))
+        object.__setattr__(self, "background", _check_background(self.background))
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_paths(
+        cls,
+        width: int,
+        height: int,
+        paths: Sequence[tuple[np.ndarray, Paint]],
+        background: Sequence[float] | None = None,
+        frame: Frame | None = None,
+    ) -> Scene:
+        """A scene from (points (3K, 2), paint) pairs in paint order."""
+        arrays = [np.asarray(points, dtype=np.float64) for points, _ in paths]
+        for index, array in enumerate(arrays):
+            if array.ndim != 2 or array.shape[1] != 2 or array.shape[0] < 3 or array.shape[0] % 3:
+                raise InputError(
+                    f"path {index} points must have shape (3K, 2) with K >= 1, got {array.shape}"
+                )
+        counts = [len(array) for array in arrays]
+        return cls(
+            width,
+            height,
+            np.concatenate(arrays) if arrays else np.zeros((0, 2)),
+            np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+            tuple(paint for _, paint in paths),
+            _check_background(background),
+            frame,
+        )
+
+    @classmethod
+    def from_arrays(
+        cls,
+        width: int,
+        height: int,
+        points: np.ndarray,
+        offsets: np.ndarray,
+        colours: np.ndarray,
+        background: Sequence[float] | None = None,
+        frame: Frame | None = None,
+    ) -> Scene:
+        """Packed points and offsets with flat RGBA ``colours`` (P, 4), clipped to [0, 1]."""
+        clipped = np.clip(np.asarray(colours, dtype=np.float64), 0.0, 1.0)
+        paints = tuple(FlatPaint(tuple(row)) for row in clipped.reshape(-1, 4))
+        return cls(width, height, points, offsets, paints, _check_background(background), frame)
+
+    # ------------------------------------------------------------------ views
+    @property
+    def path_count(self) -> int:
+        return len(self.offsets) - 1
+
+    def segment_counts(self) -> np.ndarray:
+        """K of every path, (P,) int64."""
+        return np.diff(self.offsets) // 3
+
+    def path_points(self, index: int) -> np.ndarray:
+        """The (3K, 2) control points of path ``index`` (a view)."""
+        return self.points[self.offsets[index] : self.offsets[index + 1]]
+
+    def paths(self) -> Iterator[tuple[np.ndarray, Paint]]:
+        """(points (3K, 2), paint) of every path in paint order."""
+        for index, paint in enumerate(self.paints):
+            yield self.path_points(index), paint
+
+    def colours(self) -> np.ndarray:
+        """Flat RGBA of every path, (P, 4) float64 (what the rasterizer draws)."""
+        if not self.paints:
+            return np.zeros((0, 4))
+        return np.array([paint.rgba for paint in self.paints], dtype=np.float64)
+
+    @property
+    def background_or_white(self) -> RGB:
+        return self.background if self.background is not None else (1.0, 1.0, 1.0)
+
+    @property
+    def parameter_count(self) -> int:
+        """Coordinates and paint values of all paths: 6K + 4 per flat path."""
+        return int(2 * len(self.points)) + sum(paint.parameter_count for paint in self.paints)
+
+    # ------------------------------------------------------------------ derived scenes
+    def with_geometry(self, points: np.ndarray, colours: np.ndarray | None = None) -> Scene:
+        """The same paths with new packed ``points`` and, optionally, new flat colours."""
+        if colours is None:
+            return replace(self, points=points)
+        return Scene.from_arrays(
+            self.width, self.height, points, self.offsets, colours, self.background, self.frame
+        )
+
+    def with_background(self, background: Sequence[float] | None) -> Scene:
+        return replace(self, background=_check_background(background))
+
+    def stacked(self, above: Scene) -> Scene:
+        """This scene with the paths of ``above`` painted on top."""
+        if (above.width, above.height) != (self.width, self.height):
+            raise InputError("scenes to stack must share a canvas")
+        return replace(
+            self,
+            points=np.concatenate([self.points, above.points]),
+            offsets=np.concatenate([self.offsets, above.offsets[1:] + len(self.points)]),
+            paints=self.paints + above.paints,
+        )
+
+    def subset(self, keep: Sequence[int] | np.ndarray) -> Scene:
+        """Only the paths at indices ``keep`` (in the order given)."""
+        indices = [int(i) for i in keep]
+        return Scene.from_paths(
+            self.width,
+            self.height,
+            [(self.path_points(i), self.paints[i]) for i in indices],
+            self.background,
+            self.frame,
+        )
+
+    def in_input_pixels(self) -> Scene:
+        """The scene on the input canvas (``frame``), coordinates divided by its scale."""
+        if self.frame is None:
+            return self
+        return Scene(
+            self.frame.width,
+            self.frame.height,
+            self.points / self.frame.scale,
+            self.offsets,
+            self.paints,
+            self.background,
+            None,
+        )
+
+    def render(self, scale: float = 1.0) -> np.ndarray:
+        """Rasterize to a float32 (H, W, 3) array in [0, 1] at ``scale`` × the canvas size; no
+        background means white."""
+        from samvg.render import render_scene  # lazy: the rasterizer loads torch and numba
+
+        return render_scene(self, scale)

@@ -1,0 +1,88 @@
+"""SAMVG stage 1: SAM's automatic masks, filter by impact, then re-prompts in large uncovered
+regions; the result is the list of masks stage 2 traces, in paint order."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from samvg.config import Config
+from samvg.imaging import filled_components, to_float_rgb
+from samvg.segment.impact import filter_by_impact, keep_all, offer_best
+from samvg.segment.prompts import uncovered_prompts
+from samvg.segment.segmenter import Segmenter
+
+
+@dataclass(frozen=True)
+class SegmentSettings:
+    """Stage 1 in working pixels (derived once from `Config` for one canvas)."""
+
+    min_pixels: float
+    filter_by_impact: bool
+    impact_threshold: float
+    reprompt_uncovered: bool
+    uncovered_radius: float
+    """Pixels."""
+    max_paths: int | None
+    seed: int
+
+    @classmethod
+    def from_config(cls, config: Config, width: int, height: int) -> SegmentSettings:
+        options = config.segment
+        return cls(
+            min_pixels=options.min_pixels(width, height),
+            filter_by_impact=options.filter_by_impact,
+            impact_threshold=options.impact_threshold,
+            reprompt_uncovered=options.reprompt_uncovered,
+            uncovered_radius=options.uncovered_radius * max(height, width),
+            max_paths=options.max_paths,
+            seed=config.seed,
+        )
+
+
+@dataclass
+class MaskSelection:
+    """Stage 1's result: masks in paint order (largest first) and how many were seen on the
+    way (SAM's masks, their components, kept by the filter, added by re-prompts)."""
+
+    masks: list[np.ndarray]
+    amg_masks: int
+    amg_components: int
+    kept_after_filter: int
+    reprompt_masks: int
+
+
+def select_masks(
+    image: np.ndarray, segmenter: Segmenter, settings: SegmentSettings
+) -> MaskSelection:
+    """AMG → filter by impact → re-prompt SAM at the centres of large uncovered regions → filter
+    the new masks (painted beneath smaller kept masks, as they will be in area order)."""
+    target = to_float_rgb(image)
+    amg = segmenter.automatic(image)
+    candidates = [part for mask in amg for part in filled_components(mask, settings.min_pixels)]
+    if settings.filter_by_impact:
+        kept, canvas = filter_by_impact(candidates, target, settings.impact_threshold)
+    else:
+        kept, canvas = keep_all(candidates, target)
+    reprompt_masks = 0
+    if settings.reprompt_uncovered:
+        prompts = uncovered_prompts(canvas.covered, settings.uncovered_radius, seed=settings.seed)
+        reprompt_masks = offer_best(
+            canvas,
+            segmenter.prompt(prompts),
+            settings.min_pixels,
+            use_filter=settings.filter_by_impact,
+            below=True,
+        )
+    pairs = list(zip(canvas.kept_masks, canvas.impacts, strict=True))
+    if settings.max_paths is not None and len(pairs) > settings.max_paths:
+        pairs = sorted(pairs, key=lambda pair: -pair[1])[: settings.max_paths]
+    pairs.sort(key=lambda pair: -int(pair[0].sum()))
+    return MaskSelection(
+        masks=[mask for mask, _ in pairs],
+        amg_masks=len(amg),
+        amg_components=len(candidates),
+        kept_after_filter=len(kept),
+        reprompt_masks=reprompt_masks,
+    )

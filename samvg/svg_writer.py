@@ -1,0 +1,68 @@
+"""SVG text of a `Scene`: width, height and viewBox, an optional background rectangle, and one
+``<path>`` of absolute cubic commands per path, coordinates rounded to a fixed precision.
+
+Written by hand: the output is a dozen lines of fixed shape, and its bytes must not depend on
+a library's formatting choices (tests compare them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from samvg.scene import Scene
+
+SVG_NAMESPACE = "http://www.w3.org/2000/svg"
+
+
+def number(value: float, precision: int) -> str:
+    """``value`` with at most ``precision`` decimals, trailing zeros and ``-0`` dropped."""
+    text = f"{value:.{precision}f}"
+    if "." in text:
+        text = text.rstrip("0").rstrip(".")
+    if text in ("-0", ""):
+        text = "0"
+    return text
+
+
+def hex_colour(rgb: Sequence[float]) -> str:
+    """``#rrggbb`` of RGB values in [0, 1] (clamped)."""
+    return "#" + "".join(f"{round(min(max(c, 0.0), 1.0) * 255):02x}" for c in rgb)
+
+
+def path_data(points: np.ndarray, precision: int) -> str:
+    """``M…C…Z`` for one closed path of 3K control points."""
+
+    def pair(p: np.ndarray) -> str:
+        return f"{number(p[0], precision)} {number(p[1], precision)}"
+
+    count = points.shape[0]
+    parts = [f"M{pair(points[0])}"]
+    for k in range(count // 3):
+        c1, c2, end = points[3 * k + 1], points[3 * k + 2], points[(3 * k + 3) % count]
+        parts.append(f"C{pair(c1)} {pair(c2)} {pair(end)}")
+    parts.append("Z")
+    return "".join(parts)
+
+
+def scene_to_svg(scene: Scene, precision: int = 2) -> str:
+    """SVG text of ``scene`` on its own canvas (convert with `Scene.in_input_pixels` first)."""
+    lines = [
+        f'<svg xmlns="{SVG_NAMESPACE}" width="{scene.width}" height="{scene.height}" '
+        f'viewBox="0 0 {scene.width} {scene.height}">'
+    ]
+    if scene.background is not None:
+        lines.append(
+            f'<rect width="{scene.width}" height="{scene.height}" '
+            f'fill="{hex_colour(scene.background)}"/>'
+        )
+    for points, paint in scene.paths():
+        opacity = paint.rgba[3]
+        opacity_attribute = "" if opacity >= 1.0 else f' fill-opacity="{number(opacity, 3)}"'
+        lines.append(
+            f'<path d="{path_data(points, precision)}" '
+            f'fill="{hex_colour(paint.rgba[:3])}"{opacity_attribute}/>'
+        )
+    lines.append("</svg>")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,42 @@
+"""SAMVG stage 2 as a pipeline stage: masks in paint order → a `Scene` of traced paths."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from samvg.config import Config
+from samvg.scene import RGB, Scene
+from samvg.trace.tracer import trace_masks
+
+
+@dataclass(frozen=True)
+class TraceSettings:
+    """Stage 2 in working pixels (derived once from `Config` for one canvas)."""
+
+    segments: int
+    min_pixels: float
+
+    @classmethod
+    def from_config(cls, config: Config, width: int, height: int) -> TraceSettings:
+        return cls(config.trace.segments, config.segment.min_pixels(width, height))
+
+
+def uncovered_background(masks: list[np.ndarray], target: np.ndarray) -> RGB:
+    """The mean colour of the pixels no mask covers (all pixels when every one is covered)."""
+    covered = np.zeros(target.shape[:2], dtype=bool)
+    for mask in masks:
+        covered |= mask
+    if (~covered).any():
+        mean = target[~covered].mean(axis=0)
+    else:
+        mean = target.reshape(-1, 3).mean(axis=0, dtype=np.float64)
+    return (float(mean[0]), float(mean[1]), float(mean[2]))
+
+
+def trace_scene(masks: list[np.ndarray], target: np.ndarray, settings: TraceSettings) -> Scene:
+    """Every component of every mask as a path filled with its mean colour (no background)."""
+    return trace_masks(
+        masks, target, segments_per_path=settings.segments, min_area=settings.min_pixels
+    )

@@ -1,0 +1,1 @@
+"""samvg's test suite (a package, so helpers import as ``tests.<folder>.<module>``)."""

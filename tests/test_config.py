@@ -1,0 +1,50 @@
+"""Config: settings grouped by stage, set by group or by name, presets as constructors."""
+
+import dataclasses
+
+import pytest
+
+from samvg import Config, InputError
+from samvg.config import FitOptions, MissingOptions, SegmentOptions, TraceOptions
+
+
+def test_settings_by_name_land_in_their_stage_group():
+    config = Config(iterations=300, points_per_side=8, segments=4, missing_rounds=2, size=256)
+    assert config.fit.iterations == 300 and config.segment.points_per_side == 8
+    assert config.trace.segments == 4 and config.missing.rounds == 2 and config.size == 256
+    assert config == Config(
+        SegmentOptions(points_per_side=8),
+        TraceOptions(segments=4),
+        FitOptions(iterations=300),
+        MissingOptions(missing_rounds=2),
+        size=256,
+    )
+
+
+def test_presets_and_replace():
+    assert Config.paper() == Config()
+    fast = Config.fast(seed=3)
+    assert fast.segment.points_per_side == 16 and not fast.fit.use_lpips and fast.seed == 3
+    changed = fast.replace(iterations=7, size=64)
+    assert changed.fit.iterations == 7 and changed.size == 64
+    assert changed.segment == fast.segment and fast.fit.iterations == 120
+    assert dataclasses.replace(fast, seed=9).seed == 9
+    assert Config(missing_components=False).missing.rounds == 0
+    assert Config().as_dict()["iterations"] == 500
+
+
+def test_unknown_and_bad_settings_are_clear_errors():
+    with pytest.raises(InputError, match="unknown setting 'iteration'"):
+        Config(iteration=5)
+    with pytest.raises(InputError, match="missing rounds"):
+        Config(missing_rounds=-1)
+    with pytest.raises(InputError, match="segments"):
+        Config(segments=0)
+    with pytest.raises(InputError, match="device"):
+        Config(device="tpu")
+
+
+def test_fractions_become_pixels_once_per_canvas():
+    options = SegmentOptions(min_area=0.001)
+    assert options.min_pixels(200, 100) == 20.0
+    assert SegmentOptions().min_pixels(10, 10) == 4.0

@@ -1,0 +1,32 @@
+"""The SVG bytes of the default and --fast settings on three images match files written before
+the scene refactor (tests/data/golden): a refactor that changes behaviour fails here.
+
+A deliberate change of output regenerates them; the commit says why.
+"""
+
+from pathlib import Path
+
+import pytest
+
+import samvg
+from samvg import Config
+
+GOLDEN = Path(__file__).parent / "data" / "golden"
+SAMPLE = Path(samvg.__file__).parent / "samples" / "sailing_sunset.png"
+IMAGES = {
+    "sailing_sunset": None,
+    "twemoji_grinning_face": "emoji/twemoji_grinning_face.png",
+    "tango_weather_clear_night": "icon/tango_weather_clear_night.png",
+}
+PRESETS = {"default": Config, "fast": Config.fast}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("preset", sorted(PRESETS))
+@pytest.mark.parametrize("name", sorted(IMAGES))
+def test_svg_bytes_match_the_golden_files(name, preset, bench_dir, sam_checkpoint, lpips_weights):
+    relative = IMAGES[name]
+    source = SAMPLE if relative is None else bench_dir / relative
+    config = PRESETS[preset](checkpoint=str(sam_checkpoint), lpips_weights=str(lpips_weights))
+    expected = (GOLDEN / f"{name}.{preset}.svg").read_text(encoding="utf-8")
+    assert samvg.vectorize(source, config).to_svg() == expected

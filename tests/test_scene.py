@@ -1,0 +1,71 @@
+"""The scene type: ragged packed paths, paints, background and the frame to input pixels."""
+
+import numpy as np
+import pytest
+
+from samvg import InputError
+from samvg.scene import FlatPaint, Frame, Scene
+
+
+def triangle(x: float, y: float, size: float) -> np.ndarray:
+    corners = np.array([[x, y], [x + size, y], [x, y + size]])
+    points = []
+    for i in range(3):
+        start, end = corners[i], corners[(i + 1) % 3]
+        points += [start, start + (end - start) / 3, start + 2 * (end - start) / 3]
+    return np.array(points)
+
+
+def square(x: float, y: float, size: float) -> np.ndarray:
+    corners = np.array([[x, y], [x + size, y], [x + size, y + size], [x, y + size]])
+    points = []
+    for i in range(4):
+        start, end = corners[i], corners[(i + 1) % 4]
+        points += [start, start + (end - start) / 3, start + 2 * (end - start) / 3]
+    return np.array(points)
+
+
+def test_paths_of_any_length_pack_and_unpack():
+    red, blue = FlatPaint((1, 0, 0)), FlatPaint((0, 0, 1, 0.5))
+    scene = Scene.from_paths(20, 10, [(triangle(1, 1, 5), red), (square(8, 2, 6), blue)])
+    assert scene.path_count == 2 and list(scene.segment_counts()) == [3, 4]
+    assert list(scene.offsets) == [0, 9, 21] and scene.points.shape == (21, 2)
+    np.testing.assert_array_equal(scene.path_points(1), square(8, 2, 6))
+    np.testing.assert_array_equal(scene.colours(), [[1, 0, 0, 1], [0, 0, 1, 0.5]])
+    assert scene.parameter_count == (6 * 3 + 4) + (6 * 4 + 4)
+    top = scene.subset([1])
+    assert top.path_count == 1 and top.paints == (blue,)
+    both = scene.stacked(top)
+    assert list(both.offsets) == [0, 9, 21, 33]
+
+
+def test_render_draws_each_path_with_its_paint():
+    scene = Scene.from_paths(
+        20, 10, [(square(0, 0, 10), FlatPaint((1, 0, 0)))], background=(0.0, 0.0, 1.0)
+    )
+    pixels = scene.render()
+    np.testing.assert_allclose(pixels[5, 5], (1, 0, 0), atol=1e-6)
+    np.testing.assert_allclose(pixels[5, 15], (0, 0, 1), atol=1e-6)
+    assert scene.render(scale=2).shape == (20, 40, 3)
+
+
+def test_frame_maps_working_pixels_to_input_pixels():
+    scene = Scene.from_paths(
+        50, 25, [(square(10, 5, 10), FlatPaint((0, 0, 0)))], frame=Frame(100, 50, 0.5)
+    )
+    out = scene.in_input_pixels()
+    assert (out.width, out.height, out.frame) == (100, 50, None)
+    np.testing.assert_allclose(out.points, scene.points * 2)
+
+
+def test_bad_scenes_are_refused():
+    with pytest.raises(InputError, match="non-finite"):
+        Scene.from_paths(8, 8, [(np.full((3, 2), np.nan), FlatPaint((0, 0, 0)))])
+    with pytest.raises(InputError, match="3K"):
+        Scene(8, 8, np.zeros((4, 2)), np.array([0, 4]), (FlatPaint((0, 0, 0)),))
+    with pytest.raises(InputError, match="paints"):
+        Scene(8, 8, np.zeros((3, 2)), np.array([0, 3]), ())
+    with pytest.raises(InputError, match="RGBA"):
+        FlatPaint((1.5, 0, 0))
+    with pytest.raises(InputError, match="width"):
+        Scene(0, 8)
