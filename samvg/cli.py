@@ -10,15 +10,33 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+import numpy as np
+from rich.console import Console
+from rich.markup import escape
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+from samvg.config import Config
 from samvg.errors import SamvgError
+from samvg.io import read_image, write_png
+from samvg.vector_image import VectorImage
+
+if TYPE_CHECKING:  # the pipeline loads torch and numba: imported when a command needs it
+    from samvg.pipeline import PipelineResult
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
 SUBCOMMANDS = ("vectorize", "segment", "render")
 
 
-def _say(console, text: str) -> None:  # type: ignore[no-untyped-def]
+def _say(console: Console, text: str) -> None:
     """Print plain text (no markup, no wrapping: paths stay on one line)."""
     console.print(text, markup=False, highlight=False, soft_wrap=True)
 
@@ -26,16 +44,7 @@ def _say(console, text: str) -> None:  # type: ignore[no-untyped-def]
 class _StageProgress:
     """Rich progress bars, one per pipeline stage, with ETA; silent when ``quiet``."""
 
-    def __init__(self, console, quiet: bool) -> None:  # type: ignore[no-untyped-def]
-        from rich.progress import (
-            BarColumn,
-            MofNCompleteColumn,
-            Progress,
-            TextColumn,
-            TimeElapsedColumn,
-            TimeRemainingColumn,
-        )
-
+    def __init__(self, console: Console, quiet: bool) -> None:
         self.progress = Progress(
             TextColumn("{task.description:<14}"),
             BarColumn(),
@@ -69,9 +78,7 @@ def _check_output(path: Path, suffixes: tuple[str, ...]) -> None:
         raise SamvgError(f"output folder {path.parent} does not exist")
 
 
-def _config(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
-    from samvg.config import Config
-
+def _config(arguments: argparse.Namespace) -> Config:
     settings: dict[str, Any] = {
         "model": arguments.model,
         "checkpoint": arguments.checkpoint,
@@ -86,13 +93,15 @@ def _config(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
         "crop_n_layers": arguments.crops,
         "threads": arguments.threads,
         "lpips_weights": arguments.lpips_weights,
+        "missing_rounds": arguments.missing_rounds,
     }
     settings.update({key: value for key, value in optional.items() if value is not None})
     if arguments.no_lpips:
         settings["use_lpips"] = False
     if arguments.no_filter:
         settings["filter_by_impact"] = False
-    return Config.fast(**settings) if arguments.fast else Config(**settings)
+    preset = "fast" if arguments.fast else arguments.preset
+    return Config.fast(**settings) if preset == "fast" else Config.paper(**settings)
 
 
 def _expand_inputs(inputs: list[str]) -> tuple[list[Path], bool]:
@@ -116,7 +125,7 @@ def _expand_inputs(inputs: list[str]) -> tuple[list[Path], bool]:
     return found, batch
 
 
-def _vectorize(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-untyped-def]
+def _vectorize(arguments: argparse.Namespace, console: Console) -> int:
     config = _config(arguments)
     inputs = arguments.inputs
     if not arguments.batch_mode:
@@ -168,11 +177,16 @@ def _vectorize(arguments: argparse.Namespace, console) -> int:  # type: ignore[n
     return 1 if failures else 0
 
 
-def _vectorize_one(  # type: ignore[no-untyped-def]
-    source: Path, output: Path, preview, config, arguments, progress, console
+def _vectorize_one(
+    source: Path,
+    output: Path,
+    preview: Path | None,
+    config: Config,
+    arguments: argparse.Namespace,
+    progress: _StageProgress,
+    console: Console,
 ) -> None:
-    from samvg.io import write_png
-    from samvg.pipeline import run
+    from samvg.pipeline import run  # lazy: loads torch and numba (slow for --help)
 
     started = time.perf_counter()
     result = run(source, config, progress=progress.report, log=lambda text: _say(console, text))
@@ -203,15 +217,13 @@ def _vectorize_one(  # type: ignore[no-untyped-def]
             _say(console, f"wrote {preview}")
 
 
-def _save_stages(result, folder: Path, precision: int) -> None:  # type: ignore[no-untyped-def]
+def _save_stages(result: PipelineResult, folder: Path, precision: int) -> None:
     """Intermediate results: masks, initial SVG, SVG after stage 3, stage-4 map, final SVG, and
     target | initial | optimized | final side by side."""
-    import numpy as np
-
-    from samvg.io import write_png
-
     folder.mkdir(parents=True, exist_ok=True)
     target = result.target
+    if target is None:
+        return
     if result.masks:
         write_png(folder / "1_masks.png", mask_overlay(target, result.masks))
     renders = [target]
@@ -232,10 +244,8 @@ def _save_stages(result, folder: Path, precision: int) -> None:  # type: ignore[
     write_png(folder / "comparison.png", np.concatenate([r[:height, :width] for r in renders], 1))
 
 
-def mask_overlay(image, masks, seed: int = 0):  # type: ignore[no-untyped-def]
+def mask_overlay(image: np.ndarray, masks: list[np.ndarray], seed: int = 0) -> np.ndarray:
     """The image dimmed, each mask tinted with its own random colour (paint order)."""
-    import numpy as np
-
     rng = np.random.default_rng(seed)
     pixels = np.asarray(image)
     overlay = pixels.astype(np.float32)
@@ -246,10 +256,8 @@ def mask_overlay(image, masks, seed: int = 0):  # type: ignore[no-untyped-def]
     return overlay
 
 
-def _segment(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-untyped-def]
-    from samvg.config import Config
-    from samvg.io import read_image, write_png
-    from samvg.segment import Segmenter
+def _segment(arguments: argparse.Namespace, console: Console) -> int:
+    from samvg.segment import Segmenter  # lazy: loads torch
 
     _check_output(arguments.output, (".png",))
     image = read_image(arguments.input)
@@ -262,10 +270,7 @@ def _segment(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-
     return 0
 
 
-def _render(arguments: argparse.Namespace, console) -> int:  # type: ignore[no-untyped-def]
-    from samvg.io import write_png
-    from samvg.vector_image import VectorImage
-
+def _render(arguments: argparse.Namespace, console: Console) -> int:
     _check_output(arguments.output, (".png",))
     image = VectorImage.load(arguments.input)
     write_png(arguments.output, image.render(scale=arguments.scale))
@@ -299,10 +304,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="write every stage's result (masks, SVGs, maps) into DIR",
     )
     vectorize.add_argument(
-        "--fast",
-        action="store_true",
-        help="quick preset: 16x16 grid, 384 px, 120 steps a phase, no LPIPS",
+        "--preset",
+        choices=("paper", "fast"),
+        default="paper",
+        help="paper: the paper's procedure (default); fast: 16x16 grid, 384 px, "
+        "120 steps a phase, no LPIPS",
     )
+    vectorize.add_argument("--fast", action="store_true", help="same as --preset fast")
     vectorize.add_argument("--max-paths", type=int, help="at most this many paths")
     vectorize.add_argument("--segments", type=int, help="cubic segments per path (default 5)")
     vectorize.add_argument(
@@ -325,6 +333,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
     vectorize.add_argument("--crops", type=int, help="SAM crop layers (test-time augmentation)")
+    vectorize.add_argument(
+        "--missing-rounds", type=int, help="rounds of stage 4, adding missing parts (default 1)"
+    )
     vectorize.add_argument("--no-lpips", action="store_true", help="optimize MSE + Xing only")
     vectorize.add_argument("--lpips-weights", help="LPIPS weight file (flat state dict)")
     vectorize.add_argument(
@@ -356,8 +367,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 error, 130 interrupted)."""
-    from rich.console import Console
-    from rich.markup import escape
 
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] not in SUBCOMMANDS and args[0] not in ("-h", "--help"):

@@ -1,5 +1,5 @@
 """`VectorImage`: the SVG boundary. A thin view of a `samvg.scene.Scene` in the input image's
-pixels, with SVG reading (`samvg.svg_reader`), writing (`samvg.svg_writer`) and rendering.
+pixels, with SVG reading (`samvg.svg.reader`), writing (`samvg.svg.writer`) and rendering.
 
 `VectorPath` is the per-path view a user builds scenes from or inspects: closed cubic control
 points (3K, 2) and a straight RGBA fill.
@@ -17,8 +17,8 @@ import numpy as np
 from samvg.errors import InputError
 from samvg.io import atomic_write_text
 from samvg.scene import RGB, RGBA, FlatPaint, Scene
-from samvg.svg_reader import read_svg
-from samvg.svg_writer import scene_to_svg
+from samvg.svg.reader import read_svg
+from samvg.svg.writer import scene_to_svg
 
 
 @dataclass
@@ -122,7 +122,7 @@ class VectorImage:
 
     @classmethod
     def from_svg(cls, text: str) -> VectorImage:
-        """Parse SVG made of filled shapes (see `samvg.svg_reader.read_svg`): a full-canvas
+        """Parse SVG made of filled shapes (see `samvg.svg.reader.read_svg`): a full-canvas
         ``<rect>`` drawn first becomes the background. Elements or attributes this model cannot
         represent raise :class:`InputError` naming them."""
         parsed = read_svg(text)

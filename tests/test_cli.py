@@ -30,11 +30,11 @@ def test_render_writes_png(tmp_path):
 def test_bad_svg_is_one_line_error_and_no_output(tmp_path, capsys):
     svg = tmp_path / "bad.svg"
     svg.write_text(
-        '<svg xmlns="http://www.w3.org/2000/svg" width="9" height="9"><circle r="3"/></svg>'
+        '<svg xmlns="http://www.w3.org/2000/svg" width="9" height="9"><text>hi</text></svg>'
     )
     assert main(["render", str(svg), "-o", str(tmp_path / "bad.png")]) == 1
     error = capsys.readouterr().err
-    assert "error:" in error and "svg/circle[1]" in error and "Traceback" not in error
+    assert "error:" in error and "svg/text[1]" in error and "Traceback" not in error
     assert not (tmp_path / "bad.png").exists()
 
 

@@ -79,12 +79,12 @@ def find_seeds(
             inside = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
             row, col = np.unravel_index(int(np.argmax(inside)), inside.shape)
             radius = float(np.clip(0.5 * inside[row, col], 1.0, MAX_RADIUS_FRACTION * short))
-            colour = target[box][region].mean(axis=0)
+            mean = target[box][region].mean(axis=0)
             seeds.append(
                 Seed(
                     centre=(box[1].start + col + 0.5, box[0].start + row + 0.5),
                     radius=radius,
-                    colour=tuple(float(c) for c in colour),
+                    colour=(float(mean[0]), float(mean[1]), float(mean[2])),
                     area=int(areas[index]),
                 )
             )
@@ -99,7 +99,11 @@ def find_seeds(
                 Seed(
                     centre=(col + 0.5, row + 0.5),
                     radius=1.0,
-                    colour=tuple(float(c) for c in target[row, col]),
+                    colour=(
+                        float(target[row, col, 0]),
+                        float(target[row, col, 1]),
+                        float(target[row, col, 2]),
+                    ),
                     area=1,
                 )
             )

@@ -14,9 +14,10 @@ from typing import Any
 import numpy as np
 
 from samvg import pipeline
-from samvg.baselines import SAMVG_PHASES, TracedSvg, Vectorized, run_baseline
+from samvg.baselines import TracedSvg, Vectorized, run_baseline
 from samvg.config import Config
 from samvg.errors import WeightsError
+from samvg.optimize import FitSettings
 
 
 @dataclass
@@ -56,16 +57,16 @@ def _samvg(config_change: dict[str, Any]) -> Callable[[MethodRun], Vectorized]:
     return vectorize_with_samvg
 
 
-def baseline_fit_options(job: MethodRun) -> dict[str, Any]:
-    """samvg's fit options for ``job``'s target; without LPIPS weights, samvg's own fallback
+def baseline_fit_settings(job: MethodRun) -> FitSettings:
+    """samvg's fit settings for ``job``'s target; without LPIPS weights, samvg's own fallback
     (MSE + Xing), noted in the record."""
     try:
-        return pipeline.fit_options(job.config, job.target)
+        return FitSettings.from_options(job.config.fit, job.target)
     except (WeightsError, ImportError) as error:
         job.details.setdefault("notes", []).append(
             f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}"
         )
-        return pipeline.fit_options(job.config)
+        return FitSettings.from_options(job.config.fit)
 
 
 def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:
@@ -81,17 +82,17 @@ def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:
                 single_run_s=round(result.run_seconds, 3),
             )
             return result
-        phases = SAMVG_PHASES if job.config.missing_components else 1
-        steps = phases * job.config.iterations
+        phases = 1 + job.config.missing.rounds
+        steps = phases * job.config.fit.iterations
         job.details["steps"] = steps
         return run_baseline(
             name,
             job.target,
             max(1, job.path_count),
-            baseline_fit_options(job),
+            baseline_fit_settings(job),
             seed=job.config.seed,
             steps=steps,
-            segments=job.config.segments,
+            segments=job.config.trace.segments,
             progress=lambda done, total: job.progress(name, done, total),
         )
 

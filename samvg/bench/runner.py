@@ -14,7 +14,6 @@ Layout of the output folder::
 from __future__ import annotations
 
 import csv
-import dataclasses
 import io
 import json
 import os
@@ -118,7 +117,7 @@ def plan_methods(names: Sequence[str], table: dict[str, Method] | None = None) -
 
 def _settings(config: Config) -> dict[str, Any]:
     """The config as run.json keeps it (JSON values, so a reloaded copy compares equal)."""
-    settings = dataclasses.asdict(config)
+    settings = config.as_dict()
     for name in _FREE_SETTINGS:
         settings.pop(name, None)
     return json.loads(json.dumps(settings, default=str))

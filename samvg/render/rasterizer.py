@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import torch
@@ -123,9 +124,17 @@ def _report_nonfinite(arr: np.ndarray, starts: np.ndarray, what: str) -> None:
 
 class _Rasterize(torch.autograd.Function):
     @staticmethod
-    def forward(  # type: ignore[override]
-        ctx, flat_pts, colors, starts, width, height, bg, tol, grad_enabled
-    ):
+    def forward(
+        ctx: Any,
+        flat_pts: torch.Tensor,
+        colors: torch.Tensor,
+        starts: np.ndarray,
+        width: int,
+        height: int,
+        bg: np.ndarray,
+        tol: float,
+        grad_enabled: bool,
+    ) -> torch.Tensor:
         # C-contiguous float64: one compiled specialization of every kernel serves all inputs.
         pts = np.ascontiguousarray(flat_pts.detach().cpu().numpy(), dtype=np.float64)
         # Absurdly far points are pulled in so no coordinate difference overflows float64.
@@ -159,7 +168,7 @@ class _Rasterize(torch.autograd.Function):
 
     @staticmethod
     @torch.autograd.function.once_differentiable
-    def backward(ctx, grad_out):  # type: ignore[override]
+    def backward(ctx: Any, grad_out: torch.Tensor) -> tuple[torch.Tensor | None, ...]:
         n_ctrl, starts, seg_n, vstart, verts, box, off, acc, under, cols = ctx.state
         go = np.array(grad_out.detach().cpu().numpy(), dtype=np.float64, order="C", copy=True)
         dcov = np.empty(ctx.largest, np.float64)

@@ -105,7 +105,9 @@ class ImpactCanvas:
             self.impacts.append(impact)
         return ImpactDecision(accept, impact, colour)
 
-    def _evaluate(self, mask: np.ndarray, below: bool):  # type: ignore[no-untyped-def]
+    def _evaluate(
+        self, mask: np.ndarray, below: bool
+    ) -> tuple[float, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
         mask = np.asarray(mask, dtype=bool)
         if mask.shape != self.error.shape:
             raise InputError(f"mask shape {mask.shape} does not match image {self.error.shape}")

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from samvg import Config, InputError
+from samvg import Config, InputError, VectorImage
 from samvg.baselines import random_init
 from samvg.bench import METHODS, Method, MethodRun, read_manifest, run_bench, write_report
 from samvg.bench.cli import main
@@ -19,13 +19,13 @@ TINY = {"size": 64, "iterations": 3}
 def stand_in_samvg(job: MethodRun):
     """A quick stand-in for samvg in the runner tests: four fitted random blobs."""
     job.progress("optimize", 1, 1)
-    return random_init(job.target, 4, steps=2, seed=job.config.seed)
+    return VectorImage.from_scene(random_init(job.target, 4, steps=2, seed=job.config.seed))
 
 
 def failing_on_folder(job: MethodRun):
     if job.image_id == "folder":
         raise RuntimeError("boom")
-    return random_init(job.target, 2, steps=1)
+    return VectorImage.from_scene(random_init(job.target, 2, steps=1))
 
 
 TABLE = {

@@ -1,14 +1,12 @@
 """Read SVG text into samvg's scene form: a pixel canvas, an optional background colour and closed
 cubic Bézier paths with straight RGBA fills. That is this module's one job.
 
-The SVG semantics come from the maintained library svgelements: it resolves ``transform`` chains,
-presentation attributes, ``style`` and ``<style>`` CSS, inheritance from groups and ``<use>``
-references, ``currentColor`` and units, and turns every path command (M/L/H/V/C/S/Q/T/A/Z, absolute
-or relative) and basic shape into segments. Around it this module adds what svgelements leaves
-lenient: a strict XML check with the standard library (refusing entity declarations), strict path
-data, length and transform syntax, element labels such as ``svg/g[1]/path[3] (id='x')`` for error
-messages, refusal of whatever the scene cannot hold (strokes, gradients, clipping, text, images,
-several subpaths, even-odd fills), and the viewBox-to-pixel mapping, computed here so that SVG
+It is built on the maintained library svgelements, which resolves transforms, ``style`` and CSS,
+inheritance through groups and ``<use>``, units, and every path command (absolute or relative,
+arcs included), so none of that is written by hand here. This module adds what svgelements leaves
+lenient or gets wrong: a strict standard-library XML check (refusing entity declarations), strict
+path, length and transform syntax, element labels for errors (``svg/g[1]/path[3] (id='x')``),
+refusal of what the scene cannot hold, and the viewBox-to-pixel map, computed here so that SVG
 written by samvg reads back to exactly the numbers in its text.
 
 A path with K segments holds 3K control points; segment k runs from ``points[3k]`` through
@@ -32,7 +30,7 @@ from samvg.errors import InputError
 
 __all__ = ["ParsedSvg", "read_svg"]
 
-SVG_NAMESPACE = "http://www.w3.org/2000/svg"
+_SVG_NAMESPACE = "http://www.w3.org/2000/svg"
 _XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 _CLOSE_TOLERANCE = 1e-6
 # Element labels travel through svgelements as an attribute; it keeps every element's own
@@ -102,7 +100,7 @@ _TRANSFORM_COUNTS = {
 }
 _HEX_COLOUR = re.compile(r"^#(?:[0-9a-fA-F]{3,4}|[0-9a-fA-F]{6}|[0-9a-fA-F]{8})$")
 
-Rgba = tuple[float, float, float, float]
+_Rgba = tuple[float, float, float, float]
 
 
 @dataclass(frozen=True)
@@ -159,7 +157,7 @@ def _is_foreign(tag: object) -> bool:
     """Comments, processing instructions and elements in other namespaces (editor metadata)."""
     if not isinstance(tag, str):
         return True
-    return tag.startswith("{") and not tag.startswith("{" + SVG_NAMESPACE + "}")
+    return tag.startswith("{") and not tag.startswith("{" + _SVG_NAMESPACE + "}")
 
 
 def _pixel_length(value: str | None, what: str) -> float | None:
@@ -383,9 +381,9 @@ def _parse_with_svgelements(root: ElementTree.Element, geometry: _Geometry) -> A
     text = ElementTree.tostring(root, encoding="unicode")
     try:
         return svgelements.SVG.parse(
-            io.StringIO(text), reify=True, ppi=96.0, color="black", on_error="raise"
+            io.StringIO(text), reify=False, ppi=96.0, color="black", on_error="raise"
         )
-    except (ValueError, TypeError, ArithmeticError, IndexError, KeyError) as error:
+    except (ValueError, TypeError, ArithmeticError, LookupError, AttributeError) as error:
         raise InputError(
             f"svg: cannot read the document: {error or type(error).__name__}"
         ) from None
@@ -396,7 +394,7 @@ def _parse_with_svgelements(root: ElementTree.Element, geometry: _Geometry) -> A
 class _Scene:
     geometry: _Geometry
     background: tuple[float, float, float] | None = None
-    paths: list[tuple[np.ndarray, Rgba]] = field(default_factory=list)
+    paths: list[tuple[np.ndarray, _Rgba]] = field(default_factory=list)
 
 
 def _label(element: Any, use_label: str | None) -> str:
@@ -447,7 +445,7 @@ def _opacity(element: Any, inherited: float, label: str) -> float:
 
 def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
     values = shape.values
-    if values.get("visibility", "visible").strip() in ("hidden", "collapse"):
+    if str(values.get("visibility", "visible")).strip() in ("hidden", "collapse"):
         return
     if str(values.get("stroke", "none")).strip() != "none":
         raise InputError(f"{label}: strokes are not supported (only filled paths)")
@@ -456,7 +454,10 @@ def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
     if isinstance(shape, svgelements.Rect) and (shape.rx or shape.ry):
         raise InputError(f"{label}: rounded rectangles are not supported")
     fill = _fill(values, opacity, label)
-    points = scene.geometry.to_pixels(_cubic_points(shape.segments(transformed=True), label))
+    # Cubics in the shape's own coordinates, then its transform: svgelements' transformed arcs
+    # are wrong under skews (it keeps ellipse axes orthogonal), while cubics map exactly.
+    local = _cubic_points(shape.segments(transformed=False), label)
+    points = scene.geometry.to_pixels(_affine(shape.transform, local))
     if not np.all(np.isfinite(points)):
         raise InputError(f"{label}: non-finite coordinates")
     if (
@@ -505,7 +506,7 @@ def _number(text: str, label: str) -> float:
     return value
 
 
-def _fill(values: dict[str, Any], opacity: float, label: str) -> Rgba:
+def _fill(values: dict[str, Any], opacity: float, label: str) -> _Rgba:
     """The element's resolved fill (svgelements has applied CSS, ``style`` and inheritance)."""
     colour_text = str(values.get("fill", "black")).strip()
     if colour_text == "none" or colour_text.startswith("url("):
@@ -518,7 +519,7 @@ def _fill(values: dict[str, Any], opacity: float, label: str) -> Rgba:
     return (red, green, blue, min(max(alpha, 0.0), 1.0))
 
 
-def _colour(text: str, label: str) -> Rgba:
+def _colour(text: str, label: str) -> _Rgba:
     """RGBA of a CSS colour. svgelements turns unknown text into black (and has aliceblue wrong),
     so names come from Pillow's CSS table and other syntax must match svgelements' patterns."""
     from PIL import ImageColor
@@ -556,15 +557,17 @@ def _cubic_points(segments: Iterable[Any], label: str) -> np.ndarray:
     start: tuple[float, float] | None = None
     current = (0.0, 0.0)
     closed = False
+    previous: Any = None
+    previous_quad_control: tuple[float, float] | None = None
     for segment in segments:
         if isinstance(segment, svgelements.Move):
             if start is not None:
                 raise InputError(several)
-            start = current = (segment.end.x, segment.end.y)
+            start = current = _xy(segment.end)
             continue
         if start is None:
             raise InputError(f"{label}: path data must start with M")
-        end = (segment.end.x, segment.end.y)
+        end = _xy(segment.end)
         if isinstance(segment, svgelements.Close):
             if not closed and _far(current, start):
                 rows.extend(_line(current, start))
@@ -572,10 +575,23 @@ def _cubic_points(segments: Iterable[Any], label: str) -> np.ndarray:
             continue
         if closed:
             raise InputError(several)
+        # svgelements reflects the previous curve's control for S and T whatever that curve was;
+        # SVG reflects only a cubic's for S and a quadratic's for T, else uses the current point.
+        quad_control = None
         if isinstance(segment, svgelements.CubicBezier):
-            rows.extend([current, _xy(segment.control1), _xy(segment.control2)])
+            wrongly_reflected = segment.smooth and not isinstance(previous, svgelements.CubicBezier)
+            control1 = current if wrongly_reflected else _xy(segment.control1)
+            rows.extend([current, control1, _xy(segment.control2)])
         elif isinstance(segment, svgelements.QuadraticBezier):
-            rows.extend(_quadratic(current, _xy(segment.control), end))
+            quad_control = _xy(segment.control)
+            if segment.smooth:
+                quad_control = current
+                if previous_quad_control is not None:
+                    quad_control = (
+                        2.0 * current[0] - previous_quad_control[0],
+                        2.0 * current[1] - previous_quad_control[1],
+                    )
+            rows.extend(_quadratic(current, quad_control, end))
         elif isinstance(segment, svgelements.Arc):
             cubics = list(segment.as_cubic_curves())
             if not cubics and _far(current, end):
@@ -587,12 +603,24 @@ def _cubic_points(segments: Iterable[Any], label: str) -> np.ndarray:
             rows.extend(_line(current, end))
         else:
             raise InputError(f"{label}: unexpected path segment {type(segment).__name__}")
-        current = end
+        current, previous, previous_quad_control = end, segment, quad_control
     if start is None or not rows:
         raise InputError(f"{label}: path has no segments")
     if not closed and _far(current, start):
         rows.extend(_line(current, start))
     return np.array(rows, dtype=np.float64)
+
+
+def _affine(matrix: Any, points: np.ndarray) -> np.ndarray:
+    """``points`` mapped by an svgelements Matrix: (a x + c y + e, b x + d y + f)."""
+    a, b, c, d, e, f = (float(getattr(matrix, name)) for name in "abcdef")
+    if (a, b, c, d, e, f) == (1.0, 0.0, 0.0, 1.0, 0.0, 0.0):
+        return points
+    result = np.empty_like(points)
+    with np.errstate(invalid="ignore", over="ignore"):  # non-finite results are refused later
+        result[:, 0] = a * points[:, 0] + c * points[:, 1] + e
+        result[:, 1] = b * points[:, 0] + d * points[:, 1] + f
+    return result
 
 
 def _xy(point: Any) -> tuple[float, float]:
