@@ -286,7 +286,25 @@ def build_parser() -> argparse.ArgumentParser:
         "`samvg INPUT -o OUT.svg` is short for `samvg vectorize INPUT -o OUT.svg`.",
     )
     commands = parser.add_subparsers(dest="command", required=True)
+    _add_vectorize_command(commands)
 
+    segment = commands.add_parser("segment", help="SAM automatic masks as a colour overlay PNG")
+    segment.add_argument("input", type=Path)
+    segment.add_argument("-o", "--output", type=Path, required=True)
+    segment.add_argument("--model", default="mobile_sam")
+    segment.add_argument("--checkpoint", help="SAM checkpoint file")
+    segment.set_defaults(handler=_segment)
+
+    render = commands.add_parser("render", help="render an SVG of filled paths to PNG")
+    render.add_argument("input", type=Path)
+    render.add_argument("-o", "--output", type=Path, required=True)
+    render.add_argument("--scale", type=float, default=1.0)
+    render.set_defaults(handler=_render)
+    return parser
+
+
+def _add_vectorize_command(commands: Any) -> None:
+    """The ``vectorize`` sub-command and its options."""
     vectorize = commands.add_parser(
         "vectorize",
         help="raster image(s) to SVG",
@@ -349,20 +367,6 @@ def build_parser() -> argparse.ArgumentParser:
     )
     vectorize.add_argument("-q", "--quiet", action="store_true", help="no progress, no summary")
     vectorize.set_defaults(handler=_vectorize)
-
-    segment = commands.add_parser("segment", help="SAM automatic masks as a colour overlay PNG")
-    segment.add_argument("input", type=Path)
-    segment.add_argument("-o", "--output", type=Path, required=True)
-    segment.add_argument("--model", default="mobile_sam")
-    segment.add_argument("--checkpoint", help="SAM checkpoint file")
-    segment.set_defaults(handler=_segment)
-
-    render = commands.add_parser("render", help="render an SVG of filled paths to PNG")
-    render.add_argument("input", type=Path)
-    render.add_argument("-o", "--output", type=Path, required=True)
-    render.add_argument("--scale", type=float, default=1.0)
-    render.set_defaults(handler=_render)
-    return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:

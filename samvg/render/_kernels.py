@@ -64,7 +64,9 @@ def _seg_end(i0: int, a: int, b: int) -> int:
 
 
 @njit(cache=True, nogil=True)
-def plan_and_flatten(ctrl, path_start, width, height, tol):
+def plan_and_flatten(
+    ctrl: np.ndarray, path_start: np.ndarray, width: int, height: int, tol: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Choose the piece count of every segment and flatten all paths.
 
     Returns ``(seg_n, path_vstart, verts)``: pieces per segment, the first vertex of each path in
@@ -141,7 +143,13 @@ def plan_and_flatten(ctrl, path_start, width, height, tol):
 
 
 @njit(cache=True, nogil=True)
-def flatten_backward(gverts, path_start, seg_n, path_vstart, n_ctrl):
+def flatten_backward(
+    gverts: np.ndarray,
+    path_start: np.ndarray,
+    seg_n: np.ndarray,
+    path_vstart: np.ndarray,
+    n_ctrl: int,
+) -> np.ndarray:
     """Chain vertex gradients (V, 2) to control-point gradients (N, 2) via the Bernstein weights."""
     g = np.zeros((n_ctrl, 2), np.float64)
     n_paths = path_start.shape[0] - 1
@@ -171,7 +179,9 @@ def flatten_backward(gverts, path_start, seg_n, path_vstart, n_ctrl):
 
 
 @njit(cache=True, nogil=True)
-def path_boxes(verts, path_vstart, width, height):
+def path_boxes(
+    verts: np.ndarray, path_vstart: np.ndarray, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Per path ``(bx0, by0, bw, bh)`` (bw without the spill column) and buffer offsets.
 
     The box is the clipped polyline bounding box widened by one pixel up and left; the buffer
@@ -218,7 +228,7 @@ def path_boxes(verts, path_vstart, width, height):
 
 
 @njit(cache=True, nogil=True)
-def _row_deposit(xa, xb, h, acc, base, bw):
+def _row_deposit(xa: float, xb: float, h: float, acc: np.ndarray, base: int, bw: int) -> None:
     """Deposit a line piece inside one pixel row (x linear from xa to xb, signed height h)."""
     lo = min(xa, xb)
     hi = max(xa, xb)
@@ -250,7 +260,10 @@ def _row_deposit(xa, xb, h, acc, base, bw):
 
 
 @njit(cache=True, nogil=True)
-def _edge_deposit(x0, y0, x1, y1, bw, bh, acc, off, stride):
+def _edge_deposit(
+    x0: float, y0: float, x1: float, y1: float, bw: int, bh: int,
+    acc: np.ndarray, off: int, stride: int,
+) -> None:  # fmt: skip
     if y0 == y1:
         return
     ylo = min(y0, y1)
@@ -276,7 +289,10 @@ def _edge_deposit(x0, y0, x1, y1, bw, bh, acc, off, stride):
 
 
 @njit(cache=True, nogil=True)
-def _path_deposits(verts, v0, v1, bx0, by0, bw, bh, acc, off):
+def _path_deposits(
+    verts: np.ndarray, v0: int, v1: int, bx0: int, by0: int, bw: int, bh: int,
+    acc: np.ndarray, off: int,
+) -> None:  # fmt: skip
     """Zero the box buffer of one path and deposit all its edges (before the row prefix sums)."""
     stride = bw + 1
     for i in range(off, off + bh * stride):
@@ -298,7 +314,11 @@ def _path_deposits(verts, v0, v1, bx0, by0, bw, bh, acc, off):
 
 
 @njit(cache=True, nogil=True)
-def render_forward(verts, path_vstart, box, off, colors, background, canvas, acc, under, keep):
+def render_forward(
+    verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray, off: np.ndarray,
+    colors: np.ndarray, background: np.ndarray, canvas: np.ndarray, acc: np.ndarray,
+    under: np.ndarray, keep: bool,
+) -> None:  # fmt: skip
     """Coverage and straight-alpha "over" compositing, path by path in paint order.
 
     ``canvas`` (H, W, 3, float32 or float64) receives the image. With ``keep`` the winding-area
@@ -354,7 +374,7 @@ def render_forward(verts, path_vstart, box, off, colors, background, canvas, acc
 
 
 @njit(cache=True, nogil=True)
-def _dacc(acc_v):
+def _dacc(acc_v: float) -> float:
     """d min(1, |acc|) / d acc away from the kinks (0 at the kinks)."""
     a = abs(acc_v)
     if a <= _EPS_ACC or a >= 1.0 - _EPS_ACC:
@@ -363,7 +383,7 @@ def _dacc(acc_v):
 
 
 @njit(cache=True, nogil=True)
-def _one_sided(acc_v, direction):
+def _one_sided(acc_v: float, direction: float) -> float:
     """One-sided derivative of min(1, |acc|) when acc moves in ``direction`` (+1 / -1)."""
     a = abs(acc_v)
     if a <= _EPS_ACC:
@@ -377,7 +397,7 @@ def _one_sided(acc_v, direction):
 
 
 @njit(cache=True, nogil=True)
-def _piece_weights(fp, s0, s1):
+def _piece_weights(fp: float, s0: float, s1: float) -> tuple[float, float]:
     """Integrals of ``(1 - s) fp`` and ``s fp`` over the parameter interval between s0 and s1."""
     if s0 > s1:
         s0, s1 = s1, s0
@@ -386,52 +406,125 @@ def _piece_weights(fp, s0, s1):
 
 
 @njit(cache=True, nogil=True)
-def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, doff, stride):
+def _horizontal_weights(
+    xa: float, ya: float, xb: float, bw: int, bh: int,
+    acc: np.ndarray, dcov: np.ndarray, off: int, doff: int, stride: int,
+) -> tuple[float, float]:  # fmt: skip
+    """(integral of (1 - s) F' ds, integral of s F' ds) along a horizontal edge a->b."""
+    dx = xb - xa
+    ga = 0.0
+    gb = 0.0
+    if dx == 0.0 or ya < 0.0 or ya > bh:
+        return ga, gb
+    r = int(math.floor(ya))
+    degenerate = ya == r
+    lo = max(min(xa, xb), 0.0)
+    hi = min(max(xa, xb), float(bw))
+    if hi <= lo:
+        return ga, gb
+    sdx = 1.0 if dx > 0.0 else -1.0
+    c = int(math.floor(lo))
+    x = lo
+    while x < hi:
+        nx = min(float(c + 1), hi)
+        s0 = (x - xa) / dx
+        s1 = (nx - xa) / dx
+        if degenerate:
+            # dL/dy from below (row r) and from above (row r - 1), averaged.
+            down = 0.0
+            up = 0.0
+            if r < bh:
+                k = off + r * stride + c
+                down = dcov[k - off + doff] * _one_sided(acc[k], sdx)
+            if r >= 1:
+                k = off + (r - 1) * stride + c
+                up = -dcov[k - off + doff] * _one_sided(acc[k], -sdx)
+            # dL/dy = -dx_piece F'  ->  F' = -(dL/dy per unit |dx|) * sign / ...
+            fp = -0.5 * (down + up) * sdx
+        else:
+            if r >= bh:
+                break
+            k = off + r * stride + c
+            fp = -dcov[k - off + doff] * _dacc(acc[k])
+        da, db = _piece_weights(fp, s0, s1)
+        ga += da
+        gb += db
+        x = nx
+        c += 1
+    return ga, gb
+
+
+@njit(cache=True, nogil=True)
+def _grid_vertical_row(
+    ga: float, gb: float, y_lo: float, y_hi: float, xa: float, ya: float, inv_dy: float,
+    sdy: float, bw: int, base: int, acc: np.ndarray, dcov: np.ndarray, off: int, doff: int,
+) -> tuple[float, float]:  # fmt: skip
+    """``(ga, gb)`` plus one row of a vertical edge lying on a pixel boundary."""
+    s0 = (y_lo - ya) * inv_dy
+    s1 = (y_hi - ya) * inv_dy
+    c = int(xa)
+    right = 0.0
+    left = 0.0
+    if 0 <= c < bw:
+        right = dcov[base + c - off + doff] * _one_sided(acc[base + c], -sdy) * sdy
+    if 1 <= c <= bw:
+        left = -dcov[base + c - 1 - off + doff] * _one_sided(acc[base + c - 1], sdy) * sdy
+    fp = 0.5 * (right + left)
+    da, db = _piece_weights(fp, s0, s1)
+    return ga + da, gb + db
+
+
+@njit(cache=True, nogil=True)
+def _sloped_row(
+    ga: float, gb: float, y_lo: float, y_hi: float, xa: float, ya: float, dx: float,
+    inv_dy: float, bw: int, base: int, acc: np.ndarray, dcov: np.ndarray, off: int, doff: int,
+) -> tuple[float, float]:  # fmt: skip
+    """``(ga, gb)`` plus the pieces of one row crossed by a sloped edge, pixel by pixel (the
+    sums keep the order of the pieces)."""
+    s_lo = (y_lo - ya) * inv_dy
+    s_hi = (y_hi - ya) * inv_dy
+    x_lo = xa + s_lo * dx
+    x_hi = xa + s_hi * dx
+    lo = min(x_lo, x_hi)
+    hi = max(x_lo, x_hi)
+    if lo >= bw or hi <= 0.0:
+        return ga, gb  # F is constant there: no gradient
+    if hi == lo:
+        c = int(math.floor(lo))
+        fp = -dcov[base + c - off + doff] * _dacc(acc[base + c])
+        da, db = _piece_weights(fp, s_lo, s_hi)
+        return ga + da, gb + db
+    x = max(lo, 0.0)
+    end = min(hi, float(bw))
+    c = int(math.floor(x))
+    # s as a function of x inside this row (well conditioned for near-vertical edges too).
+    ds_dx = (s_hi - s_lo) / (x_hi - x_lo)
+    while x < end:
+        nx = min(float(c + 1), end)
+        s0 = s_lo + (x - x_lo) * ds_dx
+        s1 = s_lo + (nx - x_lo) * ds_dx
+        fp = -dcov[base + c - off + doff] * _dacc(acc[base + c])
+        da, db = _piece_weights(fp, s0, s1)
+        ga += da
+        gb += db
+        x = nx
+        c += 1
+    return ga, gb
+
+
+@njit(cache=True, nogil=True)
+def _edge_backward(
+    xa: float, ya: float, xb: float, yb: float, bw: int, bh: int,
+    acc: np.ndarray, dcov: np.ndarray, off: int, doff: int, stride: int,
+) -> tuple[float, float, float, float]:  # fmt: skip
     """Return (gxa, gya, gxb, gyb): dL/d endpoints of edge a->b (box coordinates)."""
     dx = xb - xa
     dy = yb - ya
+    if dy == 0.0:
+        ga, gb = _horizontal_weights(xa, ya, xb, bw, bh, acc, dcov, off, doff, stride)
+        return ga * dy, -ga * dx, gb * dy, -gb * dx
     ga = 0.0  # integral of (1 - s) F' ds
     gb = 0.0  # integral of s F' ds
-    if dy == 0.0:
-        if dx == 0.0 or ya < 0.0 or ya > bh:
-            return 0.0, 0.0, 0.0, 0.0
-        r = int(math.floor(ya))
-        degenerate = ya == r
-        lo = max(min(xa, xb), 0.0)
-        hi = min(max(xa, xb), float(bw))
-        if hi <= lo:
-            return 0.0, 0.0, 0.0, 0.0
-        sdx = 1.0 if dx > 0.0 else -1.0
-        c = int(math.floor(lo))
-        x = lo
-        while x < hi:
-            nx = min(float(c + 1), hi)
-            s0 = (x - xa) / dx
-            s1 = (nx - xa) / dx
-            if degenerate:
-                # dL/dy from below (row r) and from above (row r - 1), averaged.
-                down = 0.0
-                up = 0.0
-                if r < bh:
-                    k = off + r * stride + c
-                    down = dcov[k - off + doff] * _one_sided(acc[k], sdx)
-                if r >= 1:
-                    k = off + (r - 1) * stride + c
-                    up = -dcov[k - off + doff] * _one_sided(acc[k], -sdx)
-                # dL/dy = -dx_piece F'  ->  F' = -(dL/dy per unit |dx|) * sign / ...
-                fp = -0.5 * (down + up) * sdx
-            else:
-                if r >= bh:
-                    break
-                k = off + r * stride + c
-                fp = -dcov[k - off + doff] * _dacc(acc[k])
-            da, db = _piece_weights(fp, s0, s1)
-            ga += da
-            gb += db
-            x = nx
-            c += 1
-        return ga * dy, -ga * dx, gb * dy, -gb * dx
-
     ylo = min(ya, yb)
     yhi = max(ya, yb)
     if yhi <= 0.0 or ylo >= bh or min(xa, xb) > bw:
@@ -441,64 +534,28 @@ def _edge_backward(xa, ya, xb, yb, bw, bh, acc, dcov, off, doff, stride):
     inv_dy = 1.0 / dy
     sdy = 1.0 if dy > 0.0 else -1.0
     vertical_on_grid = dx == 0.0 and 0.0 <= xa <= bw and xa == math.floor(xa)
-    r0 = int(math.floor(ys))
-    r1 = int(math.ceil(ye))
-    for r in range(r0, r1):
+    for r in range(int(math.floor(ys)), int(math.ceil(ye))):
         y_lo = max(ys, float(r))
         y_hi = min(ye, float(r + 1))
         if y_hi <= y_lo:
             continue
         base = off + r * stride
         if vertical_on_grid:
-            s0 = (y_lo - ya) * inv_dy
-            s1 = (y_hi - ya) * inv_dy
-            c = int(xa)
-            right = 0.0
-            left = 0.0
-            if 0 <= c < bw:
-                right = dcov[base + c - off + doff] * _one_sided(acc[base + c], -sdy) * sdy
-            if 1 <= c <= bw:
-                left = -dcov[base + c - 1 - off + doff] * _one_sided(acc[base + c - 1], sdy) * sdy
-            fp = 0.5 * (right + left)
-            da, db = _piece_weights(fp, s0, s1)
-            ga += da
-            gb += db
-            continue
-        s_lo = (y_lo - ya) * inv_dy
-        s_hi = (y_hi - ya) * inv_dy
-        x_lo = xa + s_lo * dx
-        x_hi = xa + s_hi * dx
-        lo = min(x_lo, x_hi)
-        hi = max(x_lo, x_hi)
-        if lo >= bw or hi <= 0.0:
-            continue  # F is constant there: no gradient
-        if hi == lo:
-            c = int(math.floor(lo))
-            fp = -dcov[base + c - off + doff] * _dacc(acc[base + c])
-            da, db = _piece_weights(fp, s_lo, s_hi)
-            ga += da
-            gb += db
-            continue
-        x = max(lo, 0.0)
-        end = min(hi, float(bw))
-        c = int(math.floor(x))
-        # s as a function of x inside this row (well conditioned for near-vertical edges too).
-        ds_dx = (s_hi - s_lo) / (x_hi - x_lo)
-        while x < end:
-            nx = min(float(c + 1), end)
-            s0 = s_lo + (x - x_lo) * ds_dx
-            s1 = s_lo + (nx - x_lo) * ds_dx
-            fp = -dcov[base + c - off + doff] * _dacc(acc[base + c])
-            da, db = _piece_weights(fp, s0, s1)
-            ga += da
-            gb += db
-            x = nx
-            c += 1
+            ga, gb = _grid_vertical_row(
+                ga, gb, y_lo, y_hi, xa, ya, inv_dy, sdy, bw, base, acc, dcov, off, doff
+            )
+        else:
+            ga, gb = _sloped_row(
+                ga, gb, y_lo, y_hi, xa, ya, dx, inv_dy, bw, base, acc, dcov, off, doff
+            )
     return ga * dy, -ga * dx, gb * dy, -gb * dx
 
 
 @njit(cache=True, nogil=True)
-def render_backward(grad_out, verts, path_vstart, box, off, colors, acc, under, dcov):
+def render_backward(
+    grad_out: np.ndarray, verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray,
+    off: np.ndarray, colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Gradients of ``render_forward``: (dL/d vertex (V, 2), dL/d colour (P, 4)).
 
     Paths are visited in reverse paint order. For each: dL/dcov of its box pixels goes to the

@@ -310,6 +310,6 @@ def test_real_sam_masks(sam_checkpoint, bench_dir, one_torch_thread):
         coverage = render_coverage(points, width, height) if points else np.zeros(mask.shape)
         scores.append(iou(coverage, filled(mask)))
     assert np.mean(scores) >= 0.9
-    assert len(result.paths) == len(info)
+    assert result.path_count == len(info)
     traced = {p.mask_index for p in info}
     assert all(i in traced for i, m in enumerate(masks) if m.sum() >= DEFAULT_MIN_AREA)

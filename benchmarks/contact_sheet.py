@@ -1,0 +1,117 @@
+"""Contact sheet for the visual check: target | samvg | VTracer (default settings), one row per
+bench image, with path counts, MSE and SVG bytes under each picture.
+
+    python benchmarks/contact_sheet.py --per-category 2 --preset fast --output sheet.png
+
+Photos and paintings may be drawn for a local look (``--categories photo,painting``), but their
+sheets must not be committed (the bench's licences forbid copies of them in the repository).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import os
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw
+
+import samvg
+from samvg.baselines import render_svg
+from samvg.imaging import resize_longest, to_float_rgb
+from samvg.io import read_image
+
+REPO = Path(__file__).resolve().parents[1]
+BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
+CELL = 256
+CAPTION = 30
+PRESETS = {"paper": samvg.Config.paper, "fast": samvg.Config.fast}
+
+
+def vtracer_default(image: np.ndarray) -> str:
+    """VTracer's SVG of a uint8 image with its default settings."""
+    import vtracer  # the bench extra
+
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, format="PNG")
+    return vtracer.convert_raw_image_to_svg(buffer.getvalue(), img_format="png")
+
+
+def cell(picture: np.ndarray, caption: str) -> Image.Image:
+    """A picture scaled into a CELL square with a caption strip below."""
+    canvas = Image.new("RGB", (CELL, CELL + CAPTION), "white")
+    image = Image.fromarray(np.round(np.clip(picture, 0, 1) * 255).astype(np.uint8))
+    image.thumbnail((CELL, CELL), Image.Resampling.LANCZOS)
+    canvas.paste(image, ((CELL - image.width) // 2, (CELL - image.height) // 2))
+    ImageDraw.Draw(canvas).text((4, CELL + 4), caption, fill="black")
+    return canvas
+
+
+def row_for(entry: dict[str, str], config: samvg.Config) -> list[Image.Image]:
+    original = read_image(BENCH / entry["png"])
+    working, scale = resize_longest(original, config.size)
+    target = to_float_rgb(working)
+    started = time.perf_counter()
+    result = samvg.run(original, config)
+    seconds = time.perf_counter() - started
+    ours = result.image.render(scale=scale)[: target.shape[0], : target.shape[1]]
+    svg = vtracer_default(working)
+    theirs = render_svg(svg, target.shape[1], target.shape[0])
+    paths_theirs = svg.count("<path")
+
+    def mse(picture: np.ndarray) -> float:
+        return float(np.mean((picture - target) ** 2))
+
+    ours_bytes = len(result.image.to_svg().encode())
+    print(
+        f"{entry['id']}: samvg {result.counts.get('paths', 0)} paths, mse {mse(ours):.4f}, "
+        f"{ours_bytes} B, {seconds:.1f} s | vtracer {paths_theirs} paths, "
+        f"mse {mse(theirs):.4f}, {len(svg)} B",
+        flush=True,
+    )
+    return [
+        cell(target, f"{entry['id'][:36]}"),
+        cell(
+            ours,
+            f"samvg {result.counts.get('paths', 0)}p {mse(ours) * 1e3:.1f}e-3 "
+            f"{ours_bytes / 1e3:.1f}kB",
+        ),
+        cell(theirs, f"vtracer {paths_theirs}p {mse(theirs) * 1e3:.1f}e-3 {len(svg) / 1e3:.0f}kB"),
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--per-category", type=int, default=2)
+    parser.add_argument("--categories", default="emoji,icon,clipart,digital_art")
+    parser.add_argument("--preset", choices=sorted(PRESETS), default="fast")
+    parser.add_argument("--output", type=Path, required=True)
+    arguments = parser.parse_args()
+    wanted = arguments.categories.split(",")
+    if arguments.output.resolve().is_relative_to(REPO) and {"photo", "painting"} & set(wanted):
+        sys.exit("photo and painting sheets stay out of the repository: write them elsewhere")
+    with open(BENCH / "manifest.csv", newline="") as handle:
+        chosen: dict[str, list[dict[str, str]]] = defaultdict(list)
+        for entry in csv.DictReader(handle):
+            if (
+                entry["category"] in wanted
+                and len(chosen[entry["category"]]) < arguments.per_category
+            ):
+                chosen[entry["category"]].append(entry)
+    config = PRESETS[arguments.preset]()
+    rows = [row_for(entry, config) for category in wanted for entry in chosen[category]]
+    sheet = Image.new("RGB", (3 * CELL, len(rows) * (CELL + CAPTION)), "white")
+    for index, row in enumerate(rows):
+        for column, picture in enumerate(row):
+            sheet.paste(picture, (column * CELL, index * (CELL + CAPTION)))
+    sheet.save(arguments.output)
+    print(f"wrote {arguments.output}")
+
+
+if __name__ == "__main__":
+    main()
