@@ -73,7 +73,7 @@ def main() -> None:
                     "method": f"samvg-{preset}",
                     "paths": counts[preset],
                     "mse": float(np.mean((render - target) ** 2)),
-                    "lpips": lpips_distance(lpips_model, render, target),
+                    "lpips": lpips_distance(lpips_model, np.clip(render, 0, 1), target),
                     **{f"t_{k}": v for k, v in result.timings.items()},
                 }
             )
@@ -92,7 +92,7 @@ def main() -> None:
                     "method": baseline,
                     "paths": path_count(output),
                     "mse": float(np.mean((render - target) ** 2)),
-                    "lpips": lpips_distance(lpips_model, render, target),
+                    "lpips": lpips_distance(lpips_model, np.clip(render, 0, 1), target),
                     "t_total": elapsed,
                 }
             )

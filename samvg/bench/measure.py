@@ -6,10 +6,8 @@ import os
 
 import numpy as np
 
+from samvg import metrics
 from samvg.errors import SamvgError
-
-# samvg.metrics is imported where it is used: it imports torch, which `samvg-bench --help` and a
-# report without FID never need (lazy imports below refer to this note).
 
 #: Per-image metrics, in the order the CSV and the summary list them.
 IMAGE_METRICS = ("mse", "psnr", "ssim", "lpips", "complexity")
@@ -20,14 +18,10 @@ class Scorer:
     creation, so missing weights stop a run before any work (``WeightsError``)."""
 
     def __init__(self, lpips_weights: str | os.PathLike[str] | None = None) -> None:
-        from samvg.metrics import load_lpips  # lazy: see the note at the top
-
-        self._lpips = load_lpips(lpips_weights, progress=False)
+        self._lpips = metrics.load_lpips(lpips_weights, progress=False)
 
     def score(self, render: np.ndarray, target: np.ndarray) -> dict[str, float]:
         """All per-image metrics of ``render`` against ``target`` (both (H, W, 3) in [0, 1])."""
-        from samvg import metrics  # lazy: see the note at the top
-
         a = np.clip(np.asarray(render, dtype=np.float32), 0.0, 1.0)
         b = np.asarray(target, dtype=np.float32)
         return {
@@ -41,8 +35,6 @@ class Scorer:
     @staticmethod
     def target_complexity(target: np.ndarray) -> float:
         """The JPEG complexity of the target itself (float32 (H, W, 3) in [0, 1])."""
-        from samvg import metrics  # lazy: see the note at the top
-
         return float(metrics.complexity(np.asarray(target, dtype=np.float32)))
 
 
@@ -59,8 +51,6 @@ def fid_scores(
     feature dimensions the covariances are singular and pytorch-fid's sqrtm would need an
     offset. Returns the values (NaN where FID could not be computed) and what went wrong.
     """
-    from samvg import metrics  # lazy: see the note at the top
-
     values = {method: float("nan") for method in renders}
     if len(targets) < 2:
         return values, ["FID needs at least two images with results from every method"]

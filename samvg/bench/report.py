@@ -249,45 +249,16 @@ def write_report(
     overall = _means(records, methods, set(common))
     for method in methods:
         overall[method]["fid"] = fid_values[method]
-    all_ids = sorted({r["id"] for r in records})
-    lines = ["# samvg-bench summary", ""]
-    run_info = _run_info(layout)
-    if run_info.get("commands"):
-        lines += ["Made by:", "", "```", run_info["commands"][-1], "```", ""]
-    settings = run_info.get("settings", {})
-    if settings:
-        keys = ("size", "iterations", "segments", "use_lpips", "seed")
-        shown = ", ".join(f"{k}={settings[k]}" for k in keys if k in settings)
-        lines += [f"Settings: {shown}.", ""]
-    lines += [
-        f"{len(common)} of {len(all_ids)} images have results from every method.",
-        "",
-        "## All images",
-        "",
+    lines = [
+        *_header_lines(layout, records, common),
         *_markdown_table(overall, methods, len(common)),
         "",
-        "## By category (FID left out: too few images per category)",
+        *_category_lines(records, methods, common),
+        *_failure_lines(records),
+        "## Notes",
         "",
+        NOTES.rstrip(),
     ]
-    categories = sorted({r.get("category", "") for r in records})
-    for name in categories:
-        ids = {r["id"] for r in records if r.get("category", "") == name} & set(common)
-        lines += [f"### {name}", ""]
-        if not ids:
-            lines += ["No image with results from every method.", ""]
-            continue
-        table = _means(records, methods, ids)
-        lines += [*_markdown_table(table, methods, len(ids), skip=("fid",)), ""]
-    failures = [r for r in records if r.get("status") != "ok"]
-    lines += ["## Failures", ""]
-    if failures:
-        lines += ["| image | method | error |", "|---|---|---|"]
-        for record in failures:
-            error = str(record.get("error", "")).splitlines()[0].replace("|", "\\|")
-            lines.append(f"| {record['id']} | {record['method']} | {error} |")
-    else:
-        lines.append("None.")
-    lines += ["", "## Notes", "", NOTES.rstrip()]
     if problems:
         lines += ["", *[f"- {problem}" for problem in problems]]
     lines += [
@@ -318,6 +289,58 @@ def write_report(
     )
     _contact_sheet(layout, records, methods, common, layout.out / "contact_sheet.png")
     return summary
+
+
+def _header_lines(layout: Layout, records: list[dict[str, Any]], common: list[str]) -> list[str]:
+    """The summary's title, command, settings and count, up to the overall table."""
+    all_ids = sorted({r["id"] for r in records})
+    lines = ["# samvg-bench summary", ""]
+    run_info = _run_info(layout)
+    if run_info.get("commands"):
+        lines += ["Made by:", "", "```", run_info["commands"][-1], "```", ""]
+    settings = run_info.get("settings", {})
+    if settings:
+        keys = ("size", "iterations", "segments", "use_lpips", "seed")
+        shown = ", ".join(f"{k}={settings[k]}" for k in keys if k in settings)
+        lines += [f"Settings: {shown}.", ""]
+    return [
+        *lines,
+        f"{len(common)} of {len(all_ids)} images have results from every method.",
+        "",
+        "## All images",
+        "",
+    ]
+
+
+def _category_lines(
+    records: list[dict[str, Any]], methods: list[str], common: list[str]
+) -> list[str]:
+    """One table per category (without FID), over its images with every method's result."""
+    lines = ["## By category (FID left out: too few images per category)", ""]
+    categories = sorted({r.get("category", "") for r in records})
+    for name in categories:
+        ids = {r["id"] for r in records if r.get("category", "") == name} & set(common)
+        lines += [f"### {name}", ""]
+        if not ids:
+            lines += ["No image with results from every method.", ""]
+            continue
+        table = _means(records, methods, ids)
+        lines += [*_markdown_table(table, methods, len(ids), skip=("fid",)), ""]
+    return lines
+
+
+def _failure_lines(records: list[dict[str, Any]]) -> list[str]:
+    """The failures section: one table row per failed record (its error's first line)."""
+    failures = [r for r in records if r.get("status") != "ok"]
+    lines = ["## Failures", ""]
+    if failures:
+        lines += ["| image | method | error |", "|---|---|---|"]
+        for record in failures:
+            error = str(record.get("error", "")).splitlines()[0].replace("|", "\\|")
+            lines.append(f"| {record['id']} | {record['method']} | {error} |")
+    else:
+        lines.append("None.")
+    return [*lines, ""]
 
 
 def _run_info(layout: Layout) -> dict[str, Any]:

@@ -225,14 +225,7 @@ def run_bench(
     if seed is not None:
         changes["seed"] = seed
     config = (config or Config()).replace(**changes)
-    layout = Layout(Path(out))
-    try:
-        layout.out.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise InputError(f"cannot create output folder {layout.out}: {error}") from None
-    _check_settings(layout, _settings(config))
-    if command:
-        _add_command(layout, command)
+    layout = _open_layout(Path(out), config, command)
     reporter = progress or _Silent()
     outcome = BenchOutcome(out=layout.out)
 
@@ -246,50 +239,75 @@ def run_bench(
     reporter.start(total)
     for image in images:
         todo = [method for method in planned if pending(image, method)]
-        if not todo:
-            continue
-        target: np.ndarray | None = None
-        target_error: str | None = None
-        try:
-            target = load_target(image.png, config.size)
-            if not layout.target(image.id).is_file():
-                layout.target(image.id).parent.mkdir(parents=True, exist_ok=True)
-                write_png(layout.target(image.id), target)
-        except Exception as error:  # one bad image must not stop the run
-            target_error = _error_text(error)
-        target_complexity = None if target is None else _safe(Scorer.target_complexity, target)
-        for method in todo:
-            reporter.begin(image.id, method.name)
-            record: dict[str, Any] = {
-                "id": image.id,
-                "category": image.category,
-                "method": method.name,
-                "status": "error",
-            }
-            if target is None:
-                record["error"] = target_error
-            else:
-                assert scorer is not None
-                record["target_complexity"] = target_complexity
-                samvg_record = _existing(layout, "samvg", image.id) or {}
-                count = samvg_record.get("paths") if samvg_record.get("status") == "ok" else None
-                if method.needs_path_count and count is None:
-                    record["error"] = "no samvg result on this image to take the path count from"
-                else:
-                    record.update(
-                        _run_one(method, image, target, config, count, scorer, layout, reporter)
-                    )
-            _write_json(layout.record(method.name, image.id), record)
-            write_results_csv(layout)
-            if record["status"] == "ok":
-                outcome.done += 1
-            else:
-                outcome.failed += 1
-            reporter.end(record)
+        if todo:
+            assert scorer is not None
+            _run_image(image, todo, config, scorer, layout, reporter, outcome)
     if report:
         write_results_csv(layout)
         write_report(layout.out, fid_weights=fid_weights, fid=fid)
     return outcome
+
+
+def _open_layout(out: Path, config: Config, command: str | None) -> Layout:
+    """The output folder, created, its run.json checked against ``config`` (or written)."""
+    layout = Layout(out)
+    try:
+        layout.out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise InputError(f"cannot create output folder {layout.out}: {error}") from None
+    _check_settings(layout, _settings(config))
+    if command:
+        _add_command(layout, command)
+    return layout
+
+
+def _run_image(
+    image: BenchImage,
+    todo: Sequence[Method],
+    config: Config,
+    scorer: Scorer,
+    layout: Layout,
+    reporter: BenchProgress,
+    outcome: BenchOutcome,
+) -> None:
+    """Run the ``todo`` methods on one image, writing each record as it finishes."""
+    target: np.ndarray | None = None
+    target_error: str | None = None
+    try:
+        target = load_target(image.png, config.size)
+        if not layout.target(image.id).is_file():
+            layout.target(image.id).parent.mkdir(parents=True, exist_ok=True)
+            write_png(layout.target(image.id), target)
+    except Exception as error:  # one bad image must not stop the run
+        target_error = _error_text(error)
+    target_complexity = None if target is None else _safe(Scorer.target_complexity, target)
+    for method in todo:
+        reporter.begin(image.id, method.name)
+        record: dict[str, Any] = {
+            "id": image.id,
+            "category": image.category,
+            "method": method.name,
+            "status": "error",
+        }
+        if target is None:
+            record["error"] = target_error
+        else:
+            record["target_complexity"] = target_complexity
+            samvg_record = _existing(layout, "samvg", image.id) or {}
+            count = samvg_record.get("paths") if samvg_record.get("status") == "ok" else None
+            if method.needs_path_count and count is None:
+                record["error"] = "no samvg result on this image to take the path count from"
+            else:
+                record.update(
+                    _run_one(method, image, target, config, count, scorer, layout, reporter)
+                )
+        _write_json(layout.record(method.name, image.id), record)
+        write_results_csv(layout)
+        if record["status"] == "ok":
+            outcome.done += 1
+        else:
+            outcome.failed += 1
+        reporter.end(record)
 
 
 def _safe(compute: Callable[[np.ndarray], float], image: np.ndarray) -> float | None:

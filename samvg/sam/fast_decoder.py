@@ -60,6 +60,11 @@ def _center(x: torch.Tensor, dim: int = -1) -> torch.Tensor:
     return x - x.mean(dim, keepdim=True)
 
 
+def _logit_scale(att: Attention) -> float:
+    """The attention's logit scale, 1 / sqrt(head dimension)."""
+    return 1.0 / math.sqrt(att.internal_dim // att.num_heads)
+
+
 @dataclass
 class DecoderState:
     """Per-prompt results of the transformer, enough to make IoU scores and masks."""
@@ -99,7 +104,7 @@ class FastDecoder:
 
     # ------------------------------------------------------------------ shared, per image
     def _precompute(self, emb: torch.Tensor) -> None:
-        md, tr = self.md, self.tr
+        tr = self.tr
         pe_enc = self.model.prompt_encoder
         l0, l1 = tr.blocks()
         fa = tr.final_attn_token_to_image
@@ -111,16 +116,14 @@ class FastDecoder:
         p = pe_enc.get_dense_pe()[0].flatten(1).t()
         self.n = s0.shape[0]
 
-        def sc(att: Attention) -> float:
-            return 1.0 / math.sqrt(att.internal_dim // att.num_heads)
-
         # layer 0, token -> image: keys and values are shared
         a = l0.cross_attn_token_to_image
         self.k0 = _heads(_lin(s0 + p, a.k_proj), h)
         self.v0 = _heads(_lin(s0, a.v_proj), h)
         # layer 0, image -> token: image queries are shared
         a = l0.cross_attn_image_to_token
-        self.q1t = (_heads(_lin(s0 + p, a.q_proj), h) * sc(a)).transpose(1, 2).contiguous()
+        q1 = _heads(_lin(s0 + p, a.q_proj), h) * _logit_scale(a)
+        self.q1t = q1.transpose(1, 2).contiguous()
         wo1, bo1 = a.out_proj.weight, a.out_proj.bias  # (C, 128)
         y1c = _center(s0 + bo1)
         self.y1_sq = (y1c * y1c).sum(1)
@@ -143,7 +146,7 @@ class FastDecoder:
         self.m1v = m1 @ a.v_proj.weight.t()
         # layer 1, image -> token
         a = l1.cross_attn_image_to_token
-        s = sc(a)
+        s = _logit_scale(a)
         zq3 = _heads(F.linear(yb1, a.q_proj.weight), h) * s
         qc3 = _heads(_lin(p + b1, a.q_proj), h) * s
         self.zqc3 = torch.cat([zq3, qc3], 1).transpose(1, 2).contiguous()  # (H, d, 2N)
@@ -167,6 +170,12 @@ class FastDecoder:
         self.b2 = b2
         basis2 = torch.cat([self.basis, cc[None]], 0) * g2  # (257, C)
         self.basis2 = basis2
+        self._precompute_output(p, fa)
+
+    def _precompute_output(self, p: torch.Tensor, fa: Attention) -> None:
+        """Shared parts of the final token->image attention and of the first transposed
+        convolution, from the second LayerNorm's factors (``y2``, ``b2``, ``basis2``)."""
+        h, y2, b2, basis2 = self.h, self.y2, self.b2, self.basis2
         # final token -> image attention
         zkf = _heads(F.linear(y2, fa.k_proj.weight), h)
         self.zkcf = torch.cat([zkf, _heads(_lin(p + b2, fa.k_proj), h)], 1).transpose(1, 2)
@@ -176,7 +185,7 @@ class FastDecoder:
         self.vcf = _lin(b2, fa.v_proj).view(h, 1, -1)
         self.mvf = basis2 @ fa.v_proj.weight.t()
         # output upscaling, first transposed conv as a (C, 4*C/4) matrix, columns (a, b, ch)
-        up = md.output_upscaling  # ConvTranspose2d, LayerNorm2d, GELU, ConvTranspose2d, GELU
+        up = self.md.output_upscaling  # ConvTranspose2d, LayerNorm2d, GELU, ConvTranspose2d, GELU
         conv1, conv2 = cast(nn.ConvTranspose2d, up[0]), cast(nn.ConvTranspose2d, up[3])
         assert conv1.bias is not None and conv2.bias is not None  # SAM's have biases
         w1 = conv1.weight  # (C, C/4, 2, 2)
@@ -242,9 +251,8 @@ class FastDecoder:
 
     def transformer(self, sparse: torch.Tensor) -> DecoderState:
         """Run the two-way transformer for B prompts (sparse tokens (B, Ts, C))."""
-        md, tr = self.md, self.tr
-        l0, l1 = tr.blocks()
-        fa = tr.final_attn_token_to_image
+        md = self.md
+        l0, l1 = self.tr.blocks()
         h = self.h
         b = sparse.shape[0]
         tok = torch.cat([md.output_tokens().unsqueeze(0).expand(b, -1, -1), sparse], dim=1)
@@ -304,6 +312,23 @@ class FastDecoder:
         lg.add_(lzc[:, :, :, 0].transpose(0, 1)).mul_(s1[:, None, None, :])
         lg.add_(lzc[:, :, :, 1].transpose(0, 1))
         a2 = torch.softmax(lg, dim=2).view(b, ht, n)
+        d, vt12, s2 = self._second_norm(a1, a2, s1, vt1, vt2)
+        iou, hyper = self._final_attention(q, pe, vt12, d, s1, s2)
+        return DecoderState(iou, hyper, s1, s2, d, vt1, vt2)
+
+    def _second_norm(
+        self,
+        a1: torch.Tensor,
+        a2: torch.Tensor,
+        s1: torch.Tensor,
+        vt1: torch.Tensor,
+        vt2: torch.Tensor,
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Factors of the second image LayerNorm from both image->token attentions (weights
+        a1, a2 (B, HT, N), values vt1, vt2): D'^T (B, 2HT+1, N), vt12 (B, 2H, T, d), s2 (B, N)."""
+        h = self.h
+        b, t = vt1.shape[0], vt1.shape[2]
+        ht, n, c = h * t, self.n, self.y2.shape[1]
         # second LayerNorm: x2c = s1*Yc + D' R' with D'^T = [s1*A1; A2; 1] (B, 2HT+1, N)
         d = torch.cat([a1 * s1[:, None, :], a2, torch.ones_like(a2[:, :1])], dim=1)
         vt12 = torch.cat([vt1, vt2], dim=1)  # (B, 2H, T, d)
@@ -314,8 +339,22 @@ class FastDecoder:
         g = torch.bmm(r, r.transpose(1, 2))
         quad = torch.bmm(g, d).mul_(d).sum(1)
         var2 = (s1 * s1 * self.yb1c_sq + 2 * s1 * cross + quad) / c
-        s2 = torch.rsqrt(var2 + self.eps2)
-        # ---- final token -> image attention
+        return d, vt12, torch.rsqrt(var2 + self.eps2)
+
+    def _final_attention(
+        self,
+        q: torch.Tensor,
+        pe: torch.Tensor,
+        vt12: torch.Tensor,
+        d: torch.Tensor,
+        s1: torch.Tensor,
+        s2: torch.Tensor,
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """The final token->image attention, then the IoU head and the hypernetworks on its
+        tokens: (iou (B, 4), hyper (B, 4, 32))."""
+        md, tr = self.md, self.tr
+        fa = tr.final_attn_token_to_image
+        h, b = self.h, q.shape[0]
         # only the IoU token and the mask tokens are read after the final attention
         k_out = 1 + md.num_mask_tokens
         q, pe = q[:, :k_out], pe[:, :k_out]
@@ -329,7 +368,7 @@ class FastDecoder:
         hyper = torch.stack(
             [mlp(mt[:, i, :]) for i, mlp in enumerate(md.output_hypernetworks_mlps)], dim=1
         )
-        return DecoderState(iou, hyper, s1, s2, d, vt1, vt2)
+        return iou, hyper
 
     def _basis_rows(self, vt12: torch.Tensor, m: torch.Tensor) -> torch.Tensor:
         """Rows of R' mapped by a shared matrix: m (257, X) -> (B, 2HT+1, X)."""
