@@ -5,7 +5,8 @@ import pytest
 from PIL import Image
 
 from samvg import InputError
-from samvg.io import read_image, to_rgb_uint8, write_png
+from samvg.imaging import to_rgb_uint8
+from samvg.io import read_image, write_png
 
 
 def test_modes_and_depths_become_rgb_uint8(tmp_path):

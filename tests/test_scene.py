@@ -5,24 +5,7 @@ import pytest
 
 from samvg import InputError
 from samvg.scene import FlatPaint, Frame, Scene
-
-
-def triangle(x: float, y: float, size: float) -> np.ndarray:
-    corners = np.array([[x, y], [x + size, y], [x, y + size]])
-    points = []
-    for i in range(3):
-        start, end = corners[i], corners[(i + 1) % 3]
-        points += [start, start + (end - start) / 3, start + 2 * (end - start) / 3]
-    return np.array(points)
-
-
-def square(x: float, y: float, size: float) -> np.ndarray:
-    corners = np.array([[x, y], [x + size, y], [x + size, y + size], [x, y + size]])
-    points = []
-    for i in range(4):
-        start, end = corners[i], corners[(i + 1) % 4]
-        points += [start, start + (end - start) / 3, start + 2 * (end - start) / 3]
-    return np.array(points)
+from tests.paths import square, triangle
 
 
 def test_paths_of_any_length_pack_and_unpack():

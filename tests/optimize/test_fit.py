@@ -6,15 +6,7 @@ import pytest
 from samvg import InputError, SamvgError
 from samvg.optimize import FitSettings, fit_scene
 from samvg.scene import FlatPaint, Scene
-
-
-def square(x0: float, y0: float, size: float) -> np.ndarray:
-    corners = np.array([[x0, y0], [x0 + size, y0], [x0 + size, y0 + size], [x0, y0 + size]])
-    points = []
-    for i in range(4):
-        start, end = corners[i], corners[(i + 1) % 4]
-        points += [start, start + (end - start) / 3, start + 2 * (end - start) / 3]
-    return np.array(points)
+from tests.paths import square
 
 
 def scene_of(paths, size=64) -> Scene:
