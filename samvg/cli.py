@@ -5,12 +5,16 @@ masks, render SVG; with progress, a closing summary and one-line errors.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import glob
+import math
+import signal
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from types import FrameType
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 from rich.console import Console
@@ -25,8 +29,10 @@ from rich.progress import (
 )
 
 from samvg.config import Config
-from samvg.errors import SamvgError
+from samvg.errors import InputError, OutputError, SamvgError
 from samvg.io import read_image, write_png
+from samvg.output_paths import batch_outputs, check_output_file, check_output_folder
+from samvg.svg.writer import check_precision
 from samvg.vector_image import VectorImage
 
 if TYPE_CHECKING:  # the pipeline loads torch and numba: imported when a command needs it
@@ -34,6 +40,9 @@ if TYPE_CHECKING:  # the pipeline loads torch and numba: imported when a command
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
 SUBCOMMANDS = ("vectorize", "segment", "render")
+MAX_RENDER_PIXELS = 2 * 89_478_485
+"""The largest PNG `samvg render` writes: Pillow's decompression-bomb limit, which refuses to
+read anything larger back."""
 
 
 def _say(console: Console, text: str) -> None:
@@ -71,11 +80,52 @@ class _StageProgress:
         self.tasks = {}
 
 
-def _check_output(path: Path, suffixes: tuple[str, ...]) -> None:
-    if path.suffix.lower() not in suffixes:
-        raise SamvgError(f"output {path} should end in {' or '.join(suffixes)}")
-    if not path.parent.resolve().is_dir():
-        raise SamvgError(f"output folder {path.parent} does not exist")
+def one_line(message: str) -> str:
+    """A message of several lines (a list of what was tried) joined into one line."""
+    text = ""
+    for line in (line.strip() for line in message.splitlines()):
+        if line:
+            text += ("" if not text else " " if text.endswith(":") else "; ") + line
+    return text
+
+
+class Interrupted(KeyboardInterrupt):
+    """A termination signal (SIGTERM) raised as an exception, as Ctrl-C raises
+    KeyboardInterrupt, so that cleanup (an atomic write's temporary file) runs."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    def interrupt(signum: int, _frame: FrameType | None) -> None:
+        raise Interrupted(signum)
+
+    try:
+        previous = signal.signal(signal.SIGTERM, interrupt)
+    except ValueError:  # not the main thread (an embedding program): leave signals alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with each error on one line (the usage is what --help is for)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"error: {message} (see {self.prog} --help)\n")
+
+
+def _check_resources(config: Config) -> None:
+    """Device, SAM and LPIPS weights, checked before any work (see `pipeline.check_resources`)."""
+    from samvg.pipeline import check_resources  # lazy: loads torch (slow for --help)
+
+    check_resources(config)
 
 
 def _config(arguments: argparse.Namespace) -> Config:
@@ -127,41 +177,58 @@ def _expand_inputs(inputs: list[str]) -> tuple[list[Path], bool]:
 
 def _vectorize(arguments: argparse.Namespace, console: Console) -> int:
     config = _config(arguments)
-    inputs = arguments.inputs
-    if not arguments.batch_mode:
-        _check_output(arguments.output, (".svg",))
-        if arguments.preview is not None:
-            _check_output(arguments.preview, (".png",))
-        progress = _StageProgress(console, arguments.quiet)
-        with progress.progress:
-            _vectorize_one(
-                inputs[0], arguments.output, arguments.preview, config, arguments, progress, console
-            )
-        return 0
+    check_precision(arguments.precision)
+    if arguments.batch_mode:
+        return _vectorize_batch(arguments, config, console)
+    source = arguments.inputs[0]
+    if not source.is_file():
+        raise InputError(f"image file not found: {source}")
+    output = check_output_file(arguments.output, (".svg",), [source])
+    preview = None
+    if arguments.preview is not None:
+        preview = check_output_file(arguments.preview, (".png",), [source], "preview")
+    stages = None
+    if arguments.save_stages is not None:
+        stages = check_output_folder(arguments.save_stages, "--save-stages folder")
+    _check_resources(config)
+    progress = _StageProgress(console, arguments.quiet)
+    with progress.progress:
+        _vectorize_one(source, output, preview, stages, config, arguments, progress, console)
+    return 0
 
-    output_folder: Path = arguments.output
-    if output_folder.suffix.lower() == ".svg":
-        raise SamvgError(f"several inputs: -o must be a folder, not {output_folder}")
+
+def _vectorize_batch(arguments: argparse.Namespace, config: Config, console: Console) -> int:
+    if Path(arguments.output).suffix.lower() == ".svg":
+        raise SamvgError(f"several inputs: -o must be a folder, not {arguments.output}")
     if arguments.preview is not None:
         raise SamvgError("--preview takes one input; in a batch use --save-stages DIR")
-    output_folder.mkdir(parents=True, exist_ok=True)
+    folder = check_output_folder(arguments.output)
+    if arguments.save_stages is not None:
+        check_output_folder(arguments.save_stages, "--save-stages folder")
+    pairs = batch_outputs(arguments.inputs, folder)
+    _check_resources(config)
+    _make_folder(folder)
     failures: list[tuple[Path, str]] = []
     done = skipped = 0
     progress = _StageProgress(console, arguments.quiet)
     with progress.progress:
-        overall = progress.progress.add_task("images", total=len(inputs))
-        for source in inputs:
-            target = output_folder / (source.stem + ".svg")
+        overall = progress.progress.add_task("images", total=len(pairs))
+        for source, target in pairs:
             if target.exists() and not arguments.overwrite:
                 skipped += 1
                 progress.progress.advance(overall)
                 continue
             progress.prefix = f"{source.stem[:8]} "
+            stages = None
+            if arguments.save_stages is not None:
+                stages = Path(arguments.save_stages) / target.name[: -len(".svg")]
             try:
-                _vectorize_one(source, target, None, config, arguments, progress, console)
+                _vectorize_one(source, target, None, stages, config, arguments, progress, console)
                 done += 1
+            except OutputError:
+                raise  # a full disk or a vanished folder fails every image after it: stop
             except SamvgError as error:
-                failures.append((source, str(error).splitlines()[0]))
+                failures.append((source, one_line(str(error))))
                 _say(console, f"failed {source}: {failures[-1][1]}")
             except Exception as error:  # noqa: BLE001 - one bad image must not stop a batch
                 failures.append((source, f"internal error {type(error).__name__}: {error}"))
@@ -177,10 +244,18 @@ def _vectorize(arguments: argparse.Namespace, console: Console) -> int:
     return 1 if failures else 0
 
 
+def _make_folder(folder: Path) -> None:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"cannot create folder {folder}: {error.strerror or error}") from None
+
+
 def _vectorize_one(
     source: Path,
     output: Path,
     preview: Path | None,
+    stages: Path | None,
     config: Config,
     arguments: argparse.Namespace,
     progress: _StageProgress,
@@ -193,13 +268,8 @@ def _vectorize_one(
     result.image.save(output, precision=arguments.precision)
     if preview is not None:
         write_png(preview, result.image.render())
-    if arguments.save_stages is not None:
-        folder = (
-            arguments.save_stages
-            if not arguments.batch_mode
-            else (arguments.save_stages / source.stem)
-        )
-        _save_stages(result, folder, arguments.precision)
+    if stages is not None:
+        _save_stages(result, stages, arguments.precision)
     if not arguments.quiet:
         for note in result.notes:
             _say(console, f"note: {note}")
@@ -220,7 +290,7 @@ def _vectorize_one(
 def _save_stages(result: PipelineResult, folder: Path, precision: int) -> None:
     """Intermediate results: masks, initial SVG, SVG after stage 3, stage-4 map, final SVG, and
     target | initial | optimized | final side by side."""
-    folder.mkdir(parents=True, exist_ok=True)
+    _make_folder(folder)
     target = result.target
     if target is None:
         return
@@ -257,30 +327,43 @@ def mask_overlay(image: np.ndarray, masks: list[np.ndarray], seed: int = 0) -> n
 
 
 def _segment(arguments: argparse.Namespace, console: Console) -> int:
+    source = arguments.input
+    if not source.is_file():
+        raise InputError(f"image file not found: {source}")
+    output = check_output_file(arguments.output, (".png",), [source])
+    config = Config(checkpoint=arguments.checkpoint, model=arguments.model, use_lpips=False)
+    image = read_image(source)
+    _check_resources(config)
     from samvg.segment import Segmenter  # lazy: loads torch
 
-    _check_output(arguments.output, (".png",))
-    image = read_image(arguments.input)
-    config = Config(checkpoint=arguments.checkpoint, model=arguments.model)
     with console.status("segmenting"):
         masks = Segmenter(config.segment, config.device).automatic(image)
     masks.sort(key=lambda m: -int(m.sum()))
-    write_png(arguments.output, mask_overlay(image, masks))
-    _say(console, f"wrote {arguments.output} ({len(masks)} masks)")
+    write_png(output, mask_overlay(image, masks))
+    _say(console, f"wrote {output} ({len(masks)} masks)")
     return 0
 
 
 def _render(arguments: argparse.Namespace, console: Console) -> int:
-    _check_output(arguments.output, (".png",))
+    output = check_output_file(arguments.output, (".png",), [arguments.input])
+    scale = arguments.scale
+    if not (math.isfinite(scale) and scale > 0):
+        raise InputError(f"--scale must be a positive number, got {scale}")
     image = VectorImage.load(arguments.input)
-    write_png(arguments.output, image.render(scale=arguments.scale))
-    _say(console, f"wrote {arguments.output}")
+    width, height = max(1, round(image.width * scale)), max(1, round(image.height * scale))
+    if width * height > MAX_RENDER_PIXELS:
+        raise InputError(
+            f"the render would be {width}x{height} pixels, over the {MAX_RENDER_PIXELS} a PNG "
+            "may have; lower --scale"
+        )
+    write_png(output, image.render(scale=scale))
+    _say(console, f"wrote {output}")
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``samvg`` command."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="samvg",
         description="Raster images to compact, editable SVG (SAMVG). "
         "`samvg INPUT -o OUT.svg` is short for `samvg vectorize INPUT -o OUT.svg`.",
@@ -290,14 +373,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     segment = commands.add_parser("segment", help="SAM automatic masks as a colour overlay PNG")
     segment.add_argument("input", type=Path)
-    segment.add_argument("-o", "--output", type=Path, required=True)
+    segment.add_argument("-o", "--output", required=True)
     segment.add_argument("--model", default="mobile_sam")
     segment.add_argument("--checkpoint", help="SAM checkpoint file")
     segment.set_defaults(handler=_segment)
 
     render = commands.add_parser("render", help="render an SVG of filled paths to PNG")
     render.add_argument("input", type=Path)
-    render.add_argument("-o", "--output", type=Path, required=True)
+    render.add_argument("-o", "--output", required=True)
     render.add_argument("--scale", type=float, default=1.0)
     render.set_defaults(handler=_render)
     return parser
@@ -312,12 +395,11 @@ def _add_vectorize_command(commands: Any) -> None:
     )
     vectorize.add_argument("input", nargs="+", help="image file(s), folder or glob pattern")
     vectorize.add_argument(
-        "-o", "--output", type=Path, required=True, help="SVG file (one input) or output folder"
+        "-o", "--output", required=True, help="SVG file (one input) or output folder"
     )
-    vectorize.add_argument("--preview", type=Path, help="also write a PNG render of the result")
+    vectorize.add_argument("--preview", help="also write a PNG render of the result")
     vectorize.add_argument(
         "--save-stages",
-        type=Path,
         metavar="DIR",
         help="write every stage's result (masks, SVGs, maps) into DIR",
     )
@@ -340,8 +422,8 @@ def _add_vectorize_command(commands: Any) -> None:
         help="working resolution, longest side (default 512); the SVG keeps "
         "the input's pixel coordinates",
     )
-    vectorize.add_argument("--seed", type=int, default=0)
-    vectorize.add_argument("--device", default="cpu")
+    vectorize.add_argument("--seed", type=int, default=0, help="random seed, 0 to 2**32 - 1")
+    vectorize.add_argument("--device", default="cpu", help="cpu (default), cuda, cuda:N or mps")
     vectorize.add_argument("--threads", type=int,
                            help="torch threads for SAM (default: torch's; 1 on a busy machine)")
     vectorize.add_argument(
@@ -361,7 +443,9 @@ def _add_vectorize_command(commands: Any) -> None:
         action="store_true",
         help="keep every SAM mask (the paper's ablation of filter by impact)",
     )
-    vectorize.add_argument("--precision", type=int, default=2, help="decimals in SVG output")
+    vectorize.add_argument(
+        "--precision", type=int, default=2, help="decimals in SVG output, 0 to 10 (default 2)"
+    )
     vectorize.add_argument(
         "--overwrite", action="store_true", help="in a batch, redo images whose SVG already exists"
     )
@@ -369,27 +453,35 @@ def _add_vectorize_command(commands: Any) -> None:
     vectorize.set_defaults(handler=_vectorize)
 
 
+def _error(console: Console, message: str) -> int:
+    """Print ``error: message`` as one line (never wrapped) and return the exit status 1."""
+    console.print(
+        f"[bold red]error:[/] {escape(one_line(message))}", highlight=False, soft_wrap=True
+    )
+    return 1
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status (0 ok, 1 error, 130 interrupted)."""
+    """Run the command line; returns the exit status (0 ok, 1 error, 2 bad arguments, 130
+    interrupted by Ctrl-C, 143 terminated by SIGTERM). Every error is one line on stderr."""
 
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] not in SUBCOMMANDS and args[0] not in ("-h", "--help"):
         args.insert(0, "vectorize")
     arguments = build_parser().parse_args(args)
     console = Console(stderr=True)
-    try:
-        if arguments.command == "vectorize":
-            arguments.inputs, arguments.batch_mode = _expand_inputs(arguments.input)
-        return int(arguments.handler(arguments, console) or 0)
-    except SamvgError as error:
-        console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, soft_wrap=True)
-        return 1
-    except MemoryError:
-        console.print("[bold red]error:[/] out of memory; try a smaller --size", highlight=False)
-        return 1
-    except KeyboardInterrupt:
-        console.print("interrupted")
-        return 130
+    with _terminate_as_interrupt():
+        try:
+            if arguments.command == "vectorize":
+                arguments.inputs, arguments.batch_mode = _expand_inputs(arguments.input)
+            return int(arguments.handler(arguments, console) or 0)
+        except SamvgError as error:
+            return _error(console, str(error))
+        except MemoryError:
+            return _error(console, "out of memory; try a smaller --size")
+        except KeyboardInterrupt as interrupt:
+            console.print("interrupted", highlight=False)
+            return 128 + (interrupt.signum if isinstance(interrupt, Interrupted) else signal.SIGINT)
 
 
 if __name__ == "__main__":

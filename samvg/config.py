@@ -12,12 +12,16 @@ group into typed settings in working pixels once, when the canvas size is known.
 from __future__ import annotations
 
 import dataclasses
+import re
 from dataclasses import dataclass
 from typing import Any
 
 from samvg.errors import InputError
 
 SAM_MODELS = ("mobile_sam", "vit_b", "vit_l", "vit_h")
+MAX_SEED = 2**32 - 1
+"""The largest seed: numpy's legacy generators take seeds below 2**32, torch below 2**64."""
+_DEVICE = re.compile(r"cpu|mps|cuda(:\d+)?")
 
 
 def _label(name: str) -> str:
@@ -117,9 +121,16 @@ class FitOptions:
     lpips_size: int = 128
     """LPIPS is computed on the render resized to this longest side (cost, not quality)."""
     lpips_weights: str | None = None
+    translucent: bool = True
+    """Learn each fill's opacity; off keeps every fill opaque (alpha 1)."""
+    margin: float | None = None
+    """Keep control points within the canvas plus this fraction of its longer side (None: no
+    bound, the paper's setting)."""
 
     def __post_init__(self) -> None:
         _check_integer(self, "iterations", 0)
+        if self.margin is not None:
+            _check_non_negative(self, "margin")
         _check_integer(self, "lpips_size", 32)
         for name in ("point_learning_rate", "colour_learning_rate", "xing_weight", "lpips_weight"):
             _check_non_negative(self, name)
@@ -225,10 +236,13 @@ class Config:
         if self.threads is not None:
             _check_integer(self, "threads", 1)
         _check_integer(self, "seed", 0)
-        if not isinstance(self.device, str) or not (
-            self.device == "cpu" or self.device.startswith(("cuda", "mps"))
-        ):
-            raise InputError(f"device must be cpu, cuda[:N] or mps, got {self.device!r}")
+        if self.seed > MAX_SEED:
+            raise InputError(
+                f"seed must be an integer from 0 to {MAX_SEED} (2**32 - 1, a seed numpy and torch "
+                f"both accept), got {self.seed}"
+            )
+        if not isinstance(self.device, str) or not _DEVICE.fullmatch(self.device):
+            raise InputError(f"device must be cpu, cuda, cuda:N or mps, got {self.device!r}")
 
     @classmethod
     def paper(cls, **overrides: Any) -> Config:

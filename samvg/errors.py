@@ -9,5 +9,15 @@ class InputError(SamvgError, ValueError):
     """Bad user input: an unreadable or corrupt file, an unsupported image mode, NaN coordinates."""
 
 
+class OutputError(SamvgError):
+    """An output that cannot be written: a folder where a file should go, a missing or read-only
+    folder, the input itself, or a write that failed (a full disk)."""
+
+
 class WeightsError(SamvgError):
     """Model weights that cannot be found, downloaded, verified or loaded."""
+
+
+class WeightsNotFoundError(WeightsError):
+    """No weight file anywhere (nothing named, none in the cache) and no download worked; the
+    only weights problem that may be met with a fallback (LPIPS off)."""

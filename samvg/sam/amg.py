@@ -95,7 +95,7 @@ class SamAutomaticMaskGenerator:
         Returns a list of dicts with ``segmentation`` (bool H x W), ``area``, ``bbox`` (XYWH),
         ``predicted_iou``, ``point_coords`` ([[x, y]]), ``stability_score``, ``crop_box`` (XYWH).
         """
-        img = to_rgb_uint8(image)
+        img = to_rgb_uint8(image, min_side=2)
         self.timings = {"encoder": 0.0, "decoder": 0.0, "masks": 0.0, "post": 0.0}
         self.image_embedding = None
         orig_size = (img.shape[0], img.shape[1])

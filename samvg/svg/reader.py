@@ -81,6 +81,9 @@ _INHERITED_PROPERTIES = {
 }
 # Expanded element count (each <use> counting its target again) above which a document is refused.
 _MAX_ELEMENTS = 1_000_000
+# Nesting depth above which a document is refused, checked before any recursive pass over it
+# (real drawings nest a few dozen levels; Python's recursion limit is 1000 frames).
+_MAX_DEPTH = 500
 
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _NUMBER_AT = re.compile(r"[\s,]*(" + _NUMBER + ")")
@@ -146,7 +149,18 @@ def _parse_xml(text: str) -> ElementTree.Element:
         raise InputError(f"not valid SVG/XML: {error}") from None
     if _local_name(root.tag) != "svg":
         raise InputError(f"root element is <{_local_name(root.tag)}>, expected <svg>")
+    _check_depth(root)
     return root
+
+
+def _check_depth(root: ElementTree.Element) -> None:
+    """Refuse documents nested over `_MAX_DEPTH` levels (iteratively: no recursion here)."""
+    stack = [(root, 1)]
+    while stack:
+        element, depth = stack.pop()
+        if depth > _MAX_DEPTH:
+            raise InputError(f"svg: elements are nested over {_MAX_DEPTH} levels deep")
+        stack.extend((child, depth + 1) for child in element)
 
 
 def _local_name(tag: object) -> str:
@@ -166,7 +180,10 @@ def _pixel_length(value: str | None, what: str) -> float | None:
     match = _PIXEL_LENGTH.match(value)
     if not match or not math.isfinite(float(match.group(1))):
         raise InputError(f"<svg> {what}={value!r}: only plain pixel lengths are supported")
-    return float(match.group(1))
+    length = float(match.group(1))
+    if length <= 0:
+        raise InputError(f"<svg> {what}={value!r}: the canvas needs a positive {what}")
+    return length
 
 
 @dataclass(frozen=True)
@@ -353,7 +370,9 @@ def _check_use_expansion(root: ElementTree.Element) -> None:
         if key in visiting:
             raise InputError(f"{element.get(_LABEL, 'svg')}: circular <use> reference")
         visiting.add(key)
-        total = 1 + sum(size(child) for child in element)
+        total = 1
+        for child in element:  # a loop, not a generator: one frame per level
+            total += size(child)
         if _local_name(element.tag) == "use":
             reference = (element.get("href") or element.get(_XLINK_HREF) or "").strip()
             target = ids.get(reference[1:])

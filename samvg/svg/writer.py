@@ -11,9 +11,25 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from samvg.errors import InputError
 from samvg.scene import Scene
 
 SVG_NAMESPACE = "http://www.w3.org/2000/svg"
+MAX_PRECISION = 10
+"""Decimals beyond this only repeat float noise (coordinates are float64 pixels)."""
+
+
+def check_precision(precision: object) -> int:
+    """``precision`` if it is a number of decimals samvg writes (0 to 10); `InputError` if not."""
+    if (
+        isinstance(precision, bool)
+        or not isinstance(precision, (int, np.integer))
+        or not 0 <= precision <= MAX_PRECISION
+    ):
+        raise InputError(
+            f"precision must be an integer from 0 to {MAX_PRECISION} (decimals), got {precision!r}"
+        )
+    return int(precision)
 
 
 def number(value: float, precision: int) -> str:
@@ -48,6 +64,7 @@ def path_data(points: np.ndarray, precision: int) -> str:
 
 def scene_to_svg(scene: Scene, precision: int = 2) -> str:
     """SVG text of ``scene`` on its own canvas (convert with `Scene.in_input_pixels` first)."""
+    check_precision(precision)
     lines = [
         f'<svg xmlns="{SVG_NAMESPACE}" width="{scene.width}" height="{scene.height}" '
         f'viewBox="0 0 {scene.width} {scene.height}">'

@@ -7,6 +7,9 @@ first corner, candidates near it are suppressed, the next maximum is taken, and 
 corners; when a shape has fewer (a disk, an ellipse), the remaining ones split the longest
 stretch between chosen corners at its arclength middle, so smooth shapes get evenly spread
 segments and every path has the same number of segments.
+
+``find_corners`` is the count-free variant for adaptive tracing: all real corners, however many
+(none on a smooth shape); the joins between them are chosen by the fit's error instead.
 """
 
 from __future__ import annotations
@@ -41,6 +44,35 @@ def turning_score(contour: np.ndarray, reach: int) -> np.ndarray:
     return np.abs(np.arctan2(cross, dot))
 
 
+def _candidates(contour: np.ndarray, reach: int, min_turn: float) -> np.ndarray:
+    """Indices of the local maxima (over ±``reach``; plateaus keep their first point) of the
+    turning score that turn by at least ``min_turn`` degrees, sharpest first."""
+    total = len(contour)
+    score = turning_score(smooth_contour(contour), reach)
+    peak = np.ones(total, dtype=bool)
+    ext = _circular(score, reach, reach)
+    for shift in range(1, reach + 1):
+        peak &= score >= ext[reach - shift : reach - shift + total]
+        peak &= score > ext[reach + shift : reach + shift + total]
+    candidates = np.flatnonzero(peak & (score >= np.deg2rad(min_turn)))
+    return candidates[np.argsort(-score[candidates], kind="stable")]
+
+
+def _suppress(candidates: np.ndarray, total: int, suppression: int, limit: int) -> list[int]:
+    """Candidates in order, skipping any within ``suppression`` points (cyclically) of one
+    already chosen, until ``limit`` are chosen."""
+    chosen: list[int] = []
+    for candidate in candidates:
+        if chosen:
+            offsets = np.abs(np.asarray(chosen) - candidate)
+            if np.min(np.minimum(offsets, total - offsets)) <= suppression:
+                continue
+        chosen.append(int(candidate))
+        if len(chosen) == limit:
+            break
+    return chosen
+
+
 def select_corners(
     contour: np.ndarray, count: int, min_turn: float = MIN_TURN_DEGREES
 ) -> np.ndarray:
@@ -52,26 +84,25 @@ def select_corners(
     if total <= count:
         return np.arange(total)
     reach = max(1, min(total // (4 * count), 4))
-    score = turning_score(smooth_contour(contour), reach)
-    # Local maxima over ±reach (plateaus keep their first point).
-    peak = np.ones(total, dtype=bool)
-    ext = _circular(score, reach, reach)
-    for shift in range(1, reach + 1):
-        peak &= score >= ext[reach - shift : reach - shift + total]
-        peak &= score > ext[reach + shift : reach + shift + total]
-    candidates = np.flatnonzero(peak & (score >= np.deg2rad(min_turn)))
-    candidates = candidates[np.argsort(-score[candidates], kind="stable")]
-    suppression = max(reach, total // (2 * count))
-    chosen: list[int] = []
-    for candidate in candidates:
-        if chosen:
-            offsets = np.abs(np.asarray(chosen) - candidate)
-            if np.min(np.minimum(offsets, total - offsets)) <= suppression:
-                continue
-        chosen.append(int(candidate))
-        if len(chosen) == count:
-            break
+    candidates = _candidates(contour, reach, min_turn)
+    chosen = _suppress(candidates, total, max(reach, total // (2 * count)), count)
     return fill_by_arclength(contour, chosen, count)
+
+
+def find_corners(
+    contour: np.ndarray, limit: int | None = None, min_turn: float = MIN_TURN_DEGREES
+) -> np.ndarray:
+    """Indices (increasing) of the real corners of a closed (N, 2) contour: every local maximum
+    of the turning score that turns by at least ``min_turn`` degrees, sharpest first, none
+    within ``2 * reach`` points of a sharper one, at most ``limit`` of them. A smooth shape
+    has none. The reach is that of :func:`select_corners` at four corners (≤ 4 points)."""
+    total = len(contour)
+    if total < 3:
+        return np.zeros(0, dtype=np.int64)
+    reach = max(1, min(total // 16, 4))
+    candidates = _candidates(np.asarray(contour, dtype=np.float64), reach, min_turn)
+    chosen = _suppress(candidates, total, 2 * reach, total if limit is None else limit)
+    return np.sort(np.asarray(chosen, dtype=np.int64))
 
 
 def fill_by_arclength(contour: np.ndarray, chosen: list[int], count: int) -> np.ndarray:

@@ -1,17 +1,22 @@
 """Masks → closed cubic paths (SAMVG stage 2): one path per connected component of each mask.
 
-Each component's outer contour (``samvg.trace.contour``; holes filled) is cut at a fixed number
-of corners (``samvg.trace.corners``) and every stretch between two corners becomes one cubic
-Bézier, fitted by least squares with Newton reparameterization and pinned to the corners
-(``samvg.trace.fit``). All stretches of all masks are fitted in one vectorized batch.
+Each component's outer contour (``samvg.trace.contour``; holes filled) becomes one closed path
+of cubic Béziers, each pinned to the joins it runs between (``samvg.trace.fit``), all
+components of all masks fitted in one vectorized batch. The segment count is either fixed
+(``segments_per_path``: the contour is cut at that many corners, ``samvg.trace.outline``; the
+paper's setting) or, given a ``tolerance`` in pixels, the fewest found such that the curve
+stays within the tolerance of the contour, with every real corner a join
+(``samvg.trace.adaptive``); paths then have different segment counts.
 
 Public API:
 
-* ``trace_masks(masks, image, segments_per_path=4, min_area=16) -> Scene``: the paths, filled
-  with the mean colour of the image under each component, in paint order.
+* ``trace_masks(masks, image, segments_per_path=4, min_area=16, tolerance=None,
+  max_segments=32) -> Scene``: the paths, filled with the mean colour of the image under each
+  component, in paint order.
 * ``trace_masks_with_info(...) -> (Scene, list[TracedPath])``: the same scene and, for each of
   its paths (same order), the source mask index, component area and fitting error.
-* ``trace_components(mask, segments=4, min_area=16) -> list[TracedPath]``: geometry only.
+* ``trace_components(mask, segments=4, min_area=16, tolerance=None, max_segments=32)
+  -> list[TracedPath]``: geometry only.
 """
 
 from __future__ import annotations
@@ -25,15 +30,17 @@ from samvg.errors import InputError
 from samvg.imaging import to_float_rgb
 from samvg.scene import FlatPaint, Scene
 from samvg.trace.contour import Components, find_components
-from samvg.trace.corners import select_corners
-from samvg.trace.fit import fit_cubics
+from samvg.trace.adaptive import (
+    DEFAULT_MAX_SEGMENTS,
+    check_max_segments,
+    check_tolerance,
+    fit_adaptive,
+)
+from samvg.trace.outline import fit_fixed
 
 #: Default smallest component kept, in pixels (a 4 × 4 block): smaller specks would cost a whole
 #: path of 3K control points for almost no pixels, and a few-pixel contour cannot carry K cubics.
 DEFAULT_MIN_AREA = 16
-#: Most contour points a stretch contributes to its cubic's fit (evenly spread along it); the
-#: fitting error is measured on the same points.
-MAX_FIT_POINTS = 64
 
 
 @dataclass(frozen=True)
@@ -41,7 +48,7 @@ class TracedPath:
     """One traced component.
 
     ``points`` (3K, 2): the closed path in :class:`~samvg.scene.Scene` layout, starting at a
-    corner. ``mask_index``: index of the source mask. ``area``: pixel count of the component
+    corner (K is the same for every path unless a tolerance chose it). ``mask_index``: index of the source mask. ``area``: pixel count of the component
     (holes not counted). ``max_error`` / ``rms_error``: max and RMS distance in pixels between the
     contour points and the fitted curve (each point to its Newton-refined parameter's point).
     """
@@ -115,68 +122,26 @@ def _as_rgb(image: object) -> np.ndarray:
     return to_float_rgb(array)
 
 
-def _densify(contour: np.ndarray, minimum: int) -> np.ndarray:
-    """Insert evenly spaced points on every edge until the contour has ``minimum`` points."""
-    if len(contour) >= minimum:
-        return contour
-    pieces = -(-minimum // len(contour))
-    following = np.roll(contour, -1, axis=0)
-    fractions = np.arange(pieces) / pieces
-    dense = contour[:, None, :] + fractions[None, :, None] * (following - contour)[:, None, :]
-    return dense.reshape(-1, 2)
-
-
-def _stretches(contour: np.ndarray, segments: int) -> tuple[np.ndarray, np.ndarray]:
-    """The contour cut at ``segments`` corners: for each stretch from a corner to the next (both
-    included) the contour indices of at most ``MAX_FIT_POINTS`` points evenly spread along it,
-    concatenated, and the number of points of each stretch."""
-    total = len(contour)
-    corners = select_corners(contour, segments)
-    while len(corners) < segments:  # cannot happen after _densify; keeps K exact regardless
-        corners = np.append(corners, corners[-1])
-    lengths = (np.append(corners[1:], corners[0]) - corners) % total
-    if segments == 1:
-        lengths[:] = total
-    sizes = np.clip(lengths + 1, 2, MAX_FIT_POINTS)  # a repeated corner: a point cubic
-    first = np.cumsum(sizes) - sizes
-    step = np.arange(int(sizes.sum())) - np.repeat(first, sizes)
-    scale = np.repeat(lengths / np.maximum(sizes - 1, 1), sizes)
-    indices = np.repeat(corners, sizes) + np.rint(step * scale).astype(np.int64)
-    return indices % total, sizes
-
-
 def _trace(
-    masks: list[np.ndarray], segments: int, min_area: float
+    masks: list[np.ndarray], segments: int, min_area: float, tolerance: float | None, cap: int
 ) -> tuple[list[TracedPath], list[Components]]:
-    """Trace every kept component of every mask; one batched fit for all stretches."""
+    """Trace every kept component of every mask: ``segments`` cubics each, or as few as fit
+    within ``tolerance`` (at most ``cap``); one batch of fits (per round) for all of them."""
     found = [find_components(mask, min_area) for mask in masks]
-    runs, sizes, owners, areas = [], [], [], []
+    contours, owners, areas = [], [], []
     for mask_index, components in enumerate(found):
         for contour, area in zip(components.contours, components.areas, strict=True):
-            contour = _densify(contour, 4 * segments)
-            indices, stretch_sizes = _stretches(contour, segments)
-            runs.append(contour[indices])
-            sizes.append(stretch_sizes)
+            contours.append(contour)
             owners.append(mask_index)
             areas.append(int(area))
-    if not runs:
-        return [], found
-    offsets = np.concatenate([[0], np.cumsum(np.concatenate(sizes))])
-    fits = fit_cubics(np.concatenate(runs), offsets)
-    controls = fits.controls.reshape(len(runs), segments, 4, 2)
-    bounds = np.concatenate([[0], np.cumsum([len(run) for run in runs])])
-    traced = []
-    for path, (mask_index, area) in enumerate(zip(owners, areas, strict=True)):
-        distances = fits.distances[bounds[path] : bounds[path + 1]]
-        traced.append(
-            TracedPath(
-                points=controls[path, :, :3, :].reshape(3 * segments, 2),
-                mask_index=mask_index,
-                area=area,
-                max_error=float(distances.max()),
-                rms_error=float(np.sqrt(np.mean(distances**2))),
-            )
-        )
+    if tolerance is None:
+        fits = fit_fixed(contours, segments)
+    else:
+        fits = fit_adaptive(contours, tolerance, cap)
+    traced = [
+        TracedPath(fit.points, mask_index, area, fit.max_error, fit.rms_error)
+        for fit, mask_index, area in zip(fits, owners, areas, strict=True)
+    ]
     return traced, found
 
 
@@ -194,15 +159,30 @@ def _mean_colours(components: Components, rgb: np.ndarray) -> list[np.ndarray]:
     return colours
 
 
+def _check_options(
+    min_area: object, tolerance: object, max_segments: object
+) -> tuple[float, float | None, int]:
+    return (
+        _check_min_area(min_area),
+        None if tolerance is None else check_tolerance(tolerance),
+        check_max_segments(max_segments),
+    )
+
+
 def trace_components(
-    mask: np.ndarray, segments: int = 4, min_area: float = DEFAULT_MIN_AREA
+    mask: np.ndarray,
+    segments: int = 4,
+    min_area: float = DEFAULT_MIN_AREA,
+    tolerance: float | None = None,
+    max_segments: int = DEFAULT_MAX_SEGMENTS,
 ) -> list[TracedPath]:
     """Trace each connected component of a boolean (H, W) mask with at least ``min_area``
-    pixels into a closed path of ``segments`` cubics, holes filled; largest component first.
-    An empty mask gives an empty list. ``mask_index`` of the results is 0."""
+    pixels into a closed path of ``segments`` cubics (or, given ``tolerance``, as few as fit
+    within it, at most ``max_segments``; see :func:`trace_masks`), holes filled; largest
+    component first. An empty mask gives an empty list. ``mask_index`` of the results is 0."""
     segments = _check_count(segments, "segments")
-    min_area = _check_min_area(min_area)
-    traced, _ = _trace([_as_bool_mask(mask, 0, None)], segments, min_area)
+    min_area, tolerance, cap = _check_options(min_area, tolerance, max_segments)
+    traced, _ = _trace([_as_bool_mask(mask, 0, None)], segments, min_area, tolerance, cap)
     return traced
 
 
@@ -211,15 +191,17 @@ def trace_masks_with_info(
     image: np.ndarray,
     segments_per_path: int = 4,
     min_area: float = DEFAULT_MIN_AREA,
+    tolerance: float | None = None,
+    max_segments: int = DEFAULT_MAX_SEGMENTS,
 ) -> tuple[Scene, list[TracedPath]]:
     """:func:`trace_masks`, plus one :class:`TracedPath` per path of the scene, in the same order
     (source mask index, component area, fitting error)."""
     segments = _check_count(segments_per_path, "segments_per_path")
-    min_area = _check_min_area(min_area)
+    min_area, tolerance, cap = _check_options(min_area, tolerance, max_segments)
     rgb = _as_rgb(image)
     height, width = rgb.shape[:2]
     binary = _as_mask_list(masks, (height, width))
-    traced, found = _trace(binary, segments, min_area)
+    traced, found = _trace(binary, segments, min_area, tolerance, cap)
     colours = [colour for components in found for colour in _mean_colours(components, rgb)]
     paths = [
         (path.points, FlatPaint((*colour, 1.0)))
@@ -233,16 +215,27 @@ def trace_masks(
     image: np.ndarray,
     segments_per_path: int = 4,
     min_area: float = DEFAULT_MIN_AREA,
+    tolerance: float | None = None,
+    max_segments: int = DEFAULT_MAX_SEGMENTS,
 ) -> Scene:
     """Trace boolean masks (a list of (H, W) arrays or an (N, H, W) array, in paint order) over
     an RGB ``image`` (H, W, 3; uint8, or float in [0, 1]) into a :class:`~samvg.scene.Scene`
     without a background.
 
     Every connected component (4-connected) of every mask with at least ``min_area`` pixels
-    becomes one closed path of ``segments_per_path`` cubic segments with its holes filled (masks
-    painted later cover them), filled opaque with the mean image colour under the component.
+    becomes one closed path with its holes filled (masks painted later cover them), filled
+    opaque with the mean image colour under the component. With ``tolerance=None`` every path
+    has ``segments_per_path`` cubic segments. With a ``tolerance`` in pixels (a positive
+    number, like potrace's ``opttolerance``), ``segments_per_path`` is ignored: each path gets
+    the fewest segments found, from 1 to ``max_segments``, such that every fitted contour point
+    is within ``tolerance`` of the curve (``TracedPath.max_error``), with every sharp corner
+    (a turn of 45° or more) a join; a path that needs more keeps ``max_segments``.
+
     Paths follow the mask order, the components of one mask largest first; empty masks and
     masks with only smaller components add nothing. Non-boolean masks (values other than 0/1),
-    masks that are not (H, W) or differ in size from the image raise :class:`InputError`.
+    masks that are not (H, W) or differ in size from the image, and bad options raise
+    :class:`InputError`.
     """
-    return trace_masks_with_info(masks, image, segments_per_path, min_area)[0]
+    return trace_masks_with_info(
+        masks, image, segments_per_path, min_area, tolerance, max_segments
+    )[0]

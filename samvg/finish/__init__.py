@@ -1,0 +1,33 @@
+"""The finish stage: clean, editable geometry before saving (see ``finish``).
+
+Bounded control points (``bounds``), simple paths (``simplicity``), no hidden paths
+(``hidden``), merged paths of near-equal colour (``merge``) and an optional palette
+(``palette``), on polygons from one flattener (``flatten``), with outlines refitted by
+``refit``.
+"""
+
+from samvg.finish.bounds import bound_paths, default_margin, margin_box
+from samvg.finish.finish import FinishResult, FinishSettings, finish_scene
+from samvg.finish.flatten import flatten_path, flatten_paths
+from samvg.finish.hidden import remove_hidden
+from samvg.finish.merge import merge_paths
+from samvg.finish.palette import snap_colours
+from samvg.finish.refit import refit_ring
+from samvg.finish.simplicity import crossing_paths, simplify_paths
+
+__all__ = [
+    "FinishResult",
+    "FinishSettings",
+    "bound_paths",
+    "crossing_paths",
+    "default_margin",
+    "finish_scene",
+    "flatten_path",
+    "flatten_paths",
+    "margin_box",
+    "merge_paths",
+    "refit_ring",
+    "remove_hidden",
+    "simplify_paths",
+    "snap_colours",
+]

@@ -1,0 +1,26 @@
+"""Applying per-path edits to a scene: a path is kept, replaced by one or more paths in its place
+in paint order (a split), or dropped; everything else about the scene is kept."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from samvg.scene import Paint, Scene
+
+Edit = Sequence[tuple[np.ndarray, Paint]]
+"""What replaces one path, bottom first: (points (3K, 2), paint) pairs; empty drops the path."""
+
+
+def apply_edits(scene: Scene, edits: Mapping[int, Edit]) -> Scene:
+    """``scene`` with path ``i`` replaced by ``edits[i]`` for every ``i`` in ``edits``."""
+    if not edits:
+        return scene
+    paths: list[tuple[np.ndarray, Paint]] = []
+    for index, (points, paint) in enumerate(scene.paths()):
+        if index in edits:
+            paths.extend(edits[index])
+        else:
+            paths.append((points, paint))
+    return Scene.from_paths(scene.width, scene.height, paths, scene.background, scene.frame)
