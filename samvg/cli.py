@@ -63,7 +63,7 @@ class _StageProgress:
             TimeRemainingColumn(),
             console=console,
             transient=True,
-            disable=quiet,
+            disable=quiet or not console.is_terminal,  # bars in a log are noise
         )
         self.tasks: dict[str, Any] = {}
         self.prefix = ""

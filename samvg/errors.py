@@ -9,9 +9,10 @@ class InputError(SamvgError, ValueError):
     """Bad user input: an unreadable or corrupt file, an unsupported image mode, NaN coordinates."""
 
 
-class OutputError(SamvgError):
+class OutputError(SamvgError, OSError):
     """An output that cannot be written: a folder where a file should go, a missing or read-only
-    folder, the input itself, or a write that failed (a full disk)."""
+    folder, the input itself, or a write that failed (a full disk). An `OSError` too, as the
+    failed write was before."""
 
 
 class WeightsError(SamvgError):

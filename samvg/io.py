@@ -69,6 +69,8 @@ def read_image(path: str | os.PathLike[str]) -> np.ndarray:
     source = Path(path)
     if not source.is_file():
         raise InputError(f"image file not found: {source}")
+    if source.stat().st_size == 0:
+        raise InputError(f"cannot read image {source}: the file is empty (0 bytes)")
     try:
         with Image.open(source) as opened:
             opened.load()

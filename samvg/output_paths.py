@@ -68,8 +68,8 @@ def check_output_folder(path: str | os.PathLike[str], what: str = "output folder
         if not os.access(folder, os.W_OK | os.X_OK):
             raise OutputError(f"{what} {folder} is not writable")
         return folder
-    existing = folder.absolute().parent
-    while not existing.exists():
+    existing = folder.parent
+    while not existing.exists() and existing != existing.parent:
         existing = existing.parent
     if not existing.is_dir():
         raise OutputError(f"cannot create {what} {folder}: {existing} is a file")

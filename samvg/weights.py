@@ -49,6 +49,7 @@ __all__ = [
     "WeightSource",
     "WeightSpec",
     "cache_dir",
+    "describe_load_error",
     "download_weights",
     "ensure_cache_folder",
     "resolve_weights",
@@ -119,6 +120,14 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
         while chunk := f.read(_CHUNK):
             h.update(chunk)
     return h.hexdigest()
+
+
+def describe_load_error(error: BaseException) -> str:
+    """One short line for why ``torch.load(weights_only=True)`` failed on a file."""
+    first = (str(error).splitlines() or [""])[0]
+    if first.startswith("Weights only load failed"):  # torch's advice here is to trust the file
+        return "not a PyTorch file of plain tensors"
+    return f"{type(error).__name__}: {first[:200]}" if first else type(error).__name__
 
 
 def verify_file(spec: WeightSpec, path: str | os.PathLike[str]) -> None:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from samvg import InputError
+from samvg import InputError, OutputError
 from samvg.imaging import to_rgb_uint8
 from samvg.io import read_image, write_png
 
@@ -33,8 +33,9 @@ def test_arrays_of_floats_and_bools_convert():
     assert to_rgb_uint8(np.zeros((4, 4), bool))[0, 0, 0] == 0
     with pytest.raises(InputError, match="NaN"):
         to_rgb_uint8(np.full((4, 4, 3), np.nan))
+    assert to_rgb_uint8(np.full((1, 1, 3), 7, np.uint8)).shape == (1, 1, 3)  # one pixel is an image
     with pytest.raises(InputError, match="too small"):
-        to_rgb_uint8(np.zeros((1, 1, 3), np.uint8))
+        to_rgb_uint8(np.zeros((1, 1, 3), np.uint8), min_side=2)  # what SAM asks for
     with pytest.raises(InputError, match="shape"):
         to_rgb_uint8(np.zeros((4, 4, 5), np.uint8))
 
@@ -56,7 +57,7 @@ def test_write_png_round_trip_and_missing_folder(tmp_path):
     image = np.linspace(0, 1, 5 * 6 * 3).reshape(5, 6, 3).astype(np.float32)
     write_png(tmp_path / "a.png", image)
     np.testing.assert_array_equal(read_image(tmp_path / "a.png"), np.round(image * 255))
-    with pytest.raises(InputError, match="does not exist"):
+    with pytest.raises(OutputError, match="does not exist"):
         write_png(tmp_path / "no" / "a.png", image)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png"]
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from samvg.baselines.common import as_target, check_counts
 from samvg.errors import SamvgError
+from samvg.imaging import to_float_rgb
 from samvg.io import atomic_write_text
 
 #: (color_precision, layer_difference) pairs tried in turn, VTracer's defaults first; for each,
@@ -86,8 +87,7 @@ def render_svg(svg: str, width: int, height: int) -> np.ndarray:
     except ValueError as error:
         raise SamvgError(f"resvg cannot render the SVG: {error}") from None
     with Image.open(io.BytesIO(bytes(png))) as opened:
-        rgb = np.asarray(opened.convert("RGB"), dtype=np.float32) / 255.0
-    return rgb
+        return to_float_rgb(opened.convert("RGB"))
 
 
 def trace_once(png: bytes, filter_speckle: int, color_precision: int, layer_difference: int) -> str:

@@ -1,8 +1,9 @@
 """Bounded geometry: every control point within the canvas plus a margin.
 
 A path with a control point outside the margin box has its painted area intersected with the box
-(shapely) and refitted (``refit.region_paths``: the largest part replaces it, others of at least
-``min_part_area`` px² follow it); a path that paints nothing on the canvas is dropped.
+(shapely) and redrawn (``trim.region_paths``: its own cubics inside the box, straight edges along
+the border; the largest part replaces it, others of at least ``min_part_area`` px² follow it); a
+path that paints nothing on the canvas is dropped.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ import shapely
 from samvg.finish.edits import Edit, apply_edits
 from samvg.finish.flatten import flatten_paths
 from samvg.finish.outline import DEGENERATE_AREA, fill_region
-from samvg.finish.refit import Box, region_paths
+from samvg.finish.refit import Box
+from samvg.finish.trim import region_paths
 from samvg.scene import Scene
 
 #: Default margin around the canvas, as a fraction of its longer side.
@@ -84,9 +86,9 @@ def bound_paths(
         if shapely.intersection(region, canvas).area < DEGENERATE_AREA:
             edits[int(index)] = []
             continue
-        paths = region_paths(
-            shapely.intersection(region, shapely.box(*box)), tolerance, min_part_area, box
-        )
+        clipped = shapely.intersection(region, shapely.box(*box))
+        sources = [scene.path_points(int(index))]
+        paths = region_paths(clipped, sources, tolerance, min_part_area, box, canvas)
         edits[int(index)] = [(points, scene.paints[index]) for points in paths]
     counts = {
         "bounds_checked": scene.path_count,

@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from samvg.errors import InputError
 from samvg.finish.bounds import bound_paths, default_margin, margin_box
 from samvg.finish.hidden import HIDDEN_TOLERANCE, remove_hidden
@@ -21,7 +23,8 @@ from samvg.scene import Scene
 
 
 def _check_number(value: object, name: str, positive: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    real = (int, float, np.integer, np.floating)
+    if isinstance(value, bool) or not isinstance(value, real) or not math.isfinite(value):
         raise InputError(f"{name} must be a finite number, got {value!r}")
     if value < 0 or (positive and value == 0):
         raise InputError(f"{name} must be {'> 0' if positive else '>= 0'}, got {value!r}")

@@ -10,6 +10,8 @@ of all paths are evaluated in one vectorized pass.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 #: Largest distance (pixels) between a cubic arc and the chord that replaces it.
@@ -43,20 +45,31 @@ def _pieces(points: np.ndarray, offsets: np.ndarray, tolerance: float) -> np.nda
     return np.clip(needed, least, MAX_PIECES).astype(np.int64)
 
 
-def flatten_paths(
-    points: np.ndarray, offsets: np.ndarray, tolerance: float = FLATTEN_TOLERANCE
-) -> tuple[np.ndarray, np.ndarray]:
-    """Flatten packed closed cubic paths (``Scene`` layout) into polygons.
-
-    Returns ``(vertices, vertex_offsets)``: polygon ``i`` is
+@dataclass(frozen=True)
+class Flattening:
+    """Polygons of packed closed cubic paths: polygon ``i`` is
     ``vertices[vertex_offsets[i] : vertex_offsets[i + 1]]`` (at least three vertices, the first
-    not repeated at the end), starting at the path's first point.
-    """
+    not repeated at the end, starting at the path's first point). Vertex ``v`` is the point at
+    parameter ``t[v]`` of the packed segment ``segment[v]`` (segment ``s`` starts at control
+    point ``3s``)."""
+
+    vertices: np.ndarray
+    vertex_offsets: np.ndarray
+    segment: np.ndarray
+    t: np.ndarray
+
+
+def flatten(
+    points: np.ndarray, offsets: np.ndarray, tolerance: float = FLATTEN_TOLERANCE
+) -> Flattening:
+    """Flatten packed closed cubic paths (``Scene`` layout) into polygons, keeping where on
+    the paths every vertex lies."""
     points = np.asarray(points, dtype=np.float64)
     offsets = np.asarray(offsets, dtype=np.int64)
     counts = np.diff(offsets) // 3
     if len(counts) == 0:
-        return np.zeros((0, 2)), np.zeros(1, dtype=np.int64)
+        empty = np.zeros(0, dtype=np.int64)
+        return Flattening(np.zeros((0, 2)), np.zeros(1, dtype=np.int64), empty, np.zeros(0))
     pieces = _pieces(points, offsets, tolerance)
     segment_first = np.concatenate([[0], np.cumsum(counts)[:-1]])
     per_path = np.add.reduceat(pieces, segment_first)
@@ -67,10 +80,18 @@ def flatten_paths(
     starts = 3 * segment
     p0, p1, p2 = points[starts], points[starts + 1], points[starts + 2]
     p3 = points[segment_ends(offsets)[segment]]
-    s = (1.0 - t)[:, None]
-    t = t[:, None]
-    vertices = s * s * s * p0 + 3.0 * t * s * s * p1 + 3.0 * t * t * s * p2 + t * t * t * p3
-    return vertices, vertex_offsets
+    s, u = (1.0 - t)[:, None], t[:, None]
+    vertices = s * s * s * p0 + 3.0 * u * s * s * p1 + 3.0 * u * u * s * p2 + u * u * u * p3
+    return Flattening(vertices, vertex_offsets, segment, t)
+
+
+def flatten_paths(
+    points: np.ndarray, offsets: np.ndarray, tolerance: float = FLATTEN_TOLERANCE
+) -> tuple[np.ndarray, np.ndarray]:
+    """Flatten packed closed cubic paths into polygons: ``(vertices, vertex_offsets)`` of
+    :class:`Flattening`."""
+    flat = flatten(points, offsets, tolerance)
+    return flat.vertices, flat.vertex_offsets
 
 
 def flatten_path(points: np.ndarray, tolerance: float = FLATTEN_TOLERANCE) -> np.ndarray:

@@ -5,10 +5,12 @@ Candidate pairs are paths within ``MERGE_DISTANCE`` px of each other (``shapely.
 ``dwithin``) whose fills differ by less than ``delta_e`` (CIE76 ΔE in CIELAB,
 ``skimage.color.rgb2lab``) with equal opacity; closest colours first. A pair merges only when no
 path painted between them in paint order intersects either (so lifting the lower one to the
-upper one's place changes no pixel), when their union is one polygon without holes (a gap under
-``MERGE_DISTANCE`` is closed by a mitred buffer out and back) and, for translucent fills, when
-they do not overlap. The merged path takes the upper one's place, the union's outline refitted
-(or the outline of the one that already contains the other), and the area-weighted mean fill.
+upper one's place changes no pixel), when they meet along at least ``MIN_CONTACT`` px (not at a
+point) and their union is one polygon without holes (a gap under ``MERGE_DISTANCE`` is closed
+by a mitred buffer out and back) and, for translucent fills, when
+they do not overlap. The merged path takes the upper one's place, the union's outline redrawn from
+the two paths' cubics (``trim.redraw_ring``; fitted afresh where a gap was closed), or the path
+that already contains the other, and the area-weighted mean fill.
 Each path merges at most once per round; rounds repeat until nothing merges.
 """
 
@@ -21,9 +23,10 @@ import shapely
 from shapely.geometry.base import BaseGeometry
 from skimage.color import rgb2lab
 
-from samvg.finish.flatten import flatten_paths
+from samvg.finish.flatten import flatten_path, flatten_paths
 from samvg.finish.outline import path_regions
-from samvg.finish.refit import Box, refit_ring
+from samvg.finish.refit import Box
+from samvg.finish.trim import redraw_ring
 from samvg.scene import FlatPaint, Paint, Scene
 
 #: Largest gap (px) between two paths that still merge.
@@ -32,6 +35,8 @@ MERGE_DISTANCE = 0.5
 AREA_TOLERANCE = 0.5
 #: Largest opacity difference of two paths that merge.
 ALPHA_TOLERANCE = 1.0 / 255.0
+#: Shortest stretch (px) along which two paths must meet to merge (not at a single point).
+MIN_CONTACT = 1.0
 MAX_ROUNDS = 16
 
 
@@ -75,20 +80,22 @@ def _candidate_pairs(
     return pairs[keep][np.argsort(distance[keep], kind="stable")]
 
 
-def _union_outline(lower: BaseGeometry, upper: BaseGeometry) -> BaseGeometry | None:
-    """The union of two areas as one hole-free polygon, or None."""
+def _union_outline(lower: BaseGeometry, upper: BaseGeometry) -> tuple[BaseGeometry | None, bool]:
+    """The union of two areas as one hole-free polygon (or None), and whether a gap between
+    them had to be closed (its vertices are then new). Areas that meet only at a point (or
+    across a gap only that narrow) do not make one polygon."""
+    radius = MERGE_DISTANCE / 2.0 + 0.01
+    grown = [shapely.buffer(area, radius, join_style="mitre") for area in (lower, upper)]
+    if shapely.intersection(*grown).area < 2.0 * radius * MIN_CONTACT:
+        return None, False
     union = shapely.union(lower, upper)
-    if not isinstance(union, shapely.Polygon):
-        radius = MERGE_DISTANCE / 2.0 + 0.01
-        grown = shapely.union(
-            shapely.buffer(lower, radius, join_style="mitre"),
-            shapely.buffer(upper, radius, join_style="mitre"),
-        )
-        union = shapely.buffer(grown, -radius, join_style="mitre")
+    closed = not isinstance(union, shapely.Polygon)
+    if closed:
+        union = shapely.buffer(shapely.union(*grown), -radius, join_style="mitre")
     if not isinstance(union, shapely.Polygon) or union.is_empty:
-        return None
+        return None, closed
     shell = shapely.Polygon(union.exterior)
-    return shell if shell.area - union.area <= AREA_TOLERANCE else None
+    return (shell if shell.area - union.area <= AREA_TOLERANCE else None), closed
 
 
 def _blocked(
@@ -113,7 +120,7 @@ def _merge_pair(paths: _Paths, lower: int, upper: int, tolerance: float, box: Bo
     translucent = not (paths.paints[lower].opaque and paths.paints[upper].opaque)
     if translucent and shapely.intersection(first, second).area > AREA_TOLERANCE:
         return False
-    outline = _union_outline(first, second)
+    outline, closed = _union_outline(first, second)
     if outline is None:
         return False
     if abs(outline.area - second.area) <= AREA_TOLERANCE and isinstance(second, shapely.Polygon):
@@ -121,12 +128,14 @@ def _merge_pair(paths: _Paths, lower: int, upper: int, tolerance: float, box: Bo
     elif abs(outline.area - first.area) <= AREA_TOLERANCE and isinstance(first, shapely.Polygon):
         points = paths.points[lower]
     else:
-        points = refit_ring(np.asarray(outline.exterior.coords)[:-1], tolerance, box)
+        ring = np.asarray(outline.exterior.coords)[:-1]
+        sources = [] if closed else [paths.points[lower], paths.points[upper]]
+        points = redraw_ring(ring, sources, tolerance, box)
     weights = np.array([first.area, second.area]) + 1e-9
     rgba = np.array([paths.paints[lower].rgba, paths.paints[upper].rgba])
     paths.paints[upper] = FlatPaint(tuple(np.clip(weights @ rgba / weights.sum(), 0.0, 1.0)))
     paths.points[upper] = points
-    paths.regions[upper] = outline
+    paths.regions[upper] = shapely.Polygon(flatten_path(points))  # what later merges cut
     paths.alive[lower] = False
     return True
 

@@ -96,18 +96,22 @@ def _polygons_in(geometry: BaseGeometry) -> list[BaseGeometry]:
     return []
 
 
-def outline_parts(geometry: BaseGeometry, min_area: float) -> list[np.ndarray]:
-    """Exterior rings (N, 2), not closed, of the polygons of ``geometry``, holes filled, largest
-    first: the largest unless it is degenerate (< ``DEGENERATE_AREA``), then every other part of
-    at least ``min_area`` px²."""
-    shells = [shapely.Polygon(part.exterior) for part in _polygons_in(geometry)]
-    shells.sort(key=lambda shell: -shell.area)
-    kept = [
-        shell
-        for index, shell in enumerate(shells)
-        if shell.area >= (DEGENERATE_AREA if index == 0 else max(min_area, DEGENERATE_AREA))
-    ]
-    return [np.asarray(shell.exterior.coords)[:-1] for shell in kept]
+def outline_parts(
+    geometry: BaseGeometry, min_area: float, canvas: BaseGeometry | None = None
+) -> list[np.ndarray]:
+    """Exterior rings (N, 2), not closed, of the polygons of ``geometry``, holes filled, by
+    decreasing area on the ``canvas`` (if given; parts off it paint nothing): the largest
+    unless it is degenerate (< ``DEGENERATE_AREA``), then every other part of at least
+    ``min_area`` px²."""
+    shells = np.array([shapely.Polygon(part.exterior) for part in _polygons_in(geometry)])
+    if len(shells) == 0:
+        return []
+    areas = shapely.area(shells if canvas is None else shapely.intersection(shells, canvas))
+    order = np.argsort(-areas, kind="stable")
+    least = np.full(len(shells), max(min_area, DEGENERATE_AREA))
+    least[0] = DEGENERATE_AREA
+    kept = order[areas[order] >= least]
+    return [np.asarray(shells[index].exterior.coords)[:-1] for index in kept]
 
 
 def path_regions(vertices: np.ndarray, vertex_offsets: np.ndarray) -> np.ndarray:

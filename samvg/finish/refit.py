@@ -16,14 +16,13 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
-from shapely.geometry.base import BaseGeometry
 
+from samvg import trace
+from samvg.errors import InputError
+from samvg.finish.cubics import Box, clip_points, path_into_box, straight_path
 from samvg.finish.flatten import flatten_path
-from samvg.finish.outline import outline_parts, simple_mask
+from samvg.finish.outline import simple_mask
 from samvg.trace.fit import fit_cubics
-
-Box = tuple[float, float, float, float]
-"""(left, top, right, bottom) in pixels: where control points may lie."""
 
 #: Largest spacing (px) of the points the cubics are fitted to.
 STEP = 1.0
@@ -76,13 +75,37 @@ def _corners(ring: np.ndarray) -> np.ndarray:
     return np.unique(np.asarray(chosen, dtype=np.int64))
 
 
-def _fit_stretches(ring: np.ndarray, corners: np.ndarray, tolerance: float) -> np.ndarray:
-    """(S, 4, 2) cubics covering the closed ring from corner to corner, in ring order."""
+def _edge_ends(ring: np.ndarray, box: Box | None) -> np.ndarray:
+    """Indices where the ring starts or stops running along the box's border (clipped outlines
+    get a corner there, so the stretch on the border is fitted on its own, straight)."""
+    if box is None:
+        return np.zeros(0, dtype=np.int64)
+    left, top, right, bottom = box
+    x, y = ring[:, 0], ring[:, 1]
+    on = (np.abs(x - left) < 1e-6) | (np.abs(x - right) < 1e-6)
+    on |= (np.abs(y - top) < 1e-6) | (np.abs(y - bottom) < 1e-6)
+    return np.flatnonzero(on & ~(np.roll(on, 1) & np.roll(on, -1)))
+
+
+def _within(controls: np.ndarray, box: Box | None) -> np.ndarray:
+    """(S,) bool: cubics whose control points all lie in the box."""
+    if box is None:
+        return np.ones(len(controls), dtype=bool)
+    left, top, right, bottom = box
+    x, y = controls[..., 0], controls[..., 1]
+    slack = 1e-6
+    inside = (x >= left - slack) & (x <= right + slack) & (y >= top - slack) & (y <= bottom + slack)
+    return np.asarray(inside.all(axis=1))
+
+
+def _fit_stretches(
+    ring: np.ndarray, corners: np.ndarray, tolerance: float, box: Box | None
+) -> np.ndarray:
+    """(S, 4, 2) cubics covering the closed ring from corner to corner, in ring order: each
+    within ``tolerance`` of its points and inside ``box``, or a stretch too short to split."""
     count = len(ring)
-    pending = [
-        (int(a), int(b))
-        for a, b in zip(corners, np.append(corners[1:], corners[0] + count), strict=True)
-    ]
+    ends = np.append(corners[1:], corners[0] + count)
+    pending = [(int(a), int(b)) for a, b in zip(corners, ends, strict=True)]
     accepted: dict[int, np.ndarray] = {}
     for round_ in range(MAX_ROUNDS + 1):
         if not pending:
@@ -90,30 +113,19 @@ def _fit_stretches(ring: np.ndarray, corners: np.ndarray, tolerance: float) -> n
         indices = [np.arange(a, b + 1) % count for a, b in pending]
         offsets = np.concatenate([[0], np.cumsum([len(i) for i in indices])])
         fits = fit_cubics(ring[np.concatenate(indices)], offsets)
+        within = _within(fits.controls, box)
         following = []
         for run, (a, b) in enumerate(pending):
             errors = fits.distances[offsets[run] : offsets[run + 1]]
-            if errors.max() <= tolerance or b - a < 3 or round_ == MAX_ROUNDS:
+            good = errors.max() <= tolerance and within[run]
+            if good or b - a < 2 or round_ == MAX_ROUNDS:
                 accepted[a] = fits.controls[run]
                 continue
-            split = a + int(np.clip(np.argmax(errors), 1, b - a - 1))
+            worst = int(np.argmax(errors)) if errors.max() > tolerance else (b - a) // 2
+            split = a + int(np.clip(worst, 1, b - a - 1))
             following += [(a, split), (split, b)]
         pending = following
     return np.stack([accepted[key] for key in sorted(accepted)])
-
-
-def straight_path(ring: np.ndarray) -> np.ndarray:
-    """A closed polygon (N, 2) as N straight cubics with handles at the thirds of each edge."""
-    ring = np.asarray(ring, dtype=np.float64)
-    delta = np.roll(ring, -1, axis=0) - ring
-    return np.stack([ring, ring + delta / 3.0, ring + 2.0 * delta / 3.0], axis=1).reshape(-1, 2)
-
-
-def _inside(points: np.ndarray, box: Box | None) -> np.ndarray:
-    if box is None:
-        return points
-    left, top, right, bottom = box
-    return np.clip(points, (left, top), (right, bottom))
 
 
 def is_simple_path(points: np.ndarray) -> bool:
@@ -127,27 +139,42 @@ def _polygon_path(ring: np.ndarray, tolerance: float, box: Box | None) -> np.nda
     simplified = shapely.simplify(shapely.Polygon(ring), tolerance, preserve_topology=True)
     coarse = np.asarray(simplified.exterior.coords)[:-1]
     if len(coarse) >= 3:
-        path = straight_path(_inside(coarse, box))
+        path = straight_path(clip_points(coarse, box))
         if is_simple_path(path):
             return path
-    return straight_path(_inside(ring, box))
+    return straight_path(clip_points(ring, box))
+
+
+def _local_fit(ring: np.ndarray, tolerance: float, box: Box | None) -> np.ndarray:
+    """The local fitter (module docstring): corners, then cubics split until they fit."""
+    dense = _densify(ring)
+    corners = np.union1d(_corners(dense), _edge_ends(dense, box))
+    cubics = _fit_stretches(dense, corners, tolerance, box)
+    return clip_points(cubics[:, :3].reshape(-1, 2), box)
+
+
+def _tracer_fit(ring: np.ndarray, tolerance: float, box: Box | None) -> np.ndarray | None:
+    """``samvg.trace.refit_outline`` (the tracer's fewest-segments fit) where the tracer has
+    it, subdivided into the box; None without it or when it refuses the ring."""
+    refit_outline = getattr(trace, "refit_outline", None)
+    if refit_outline is None:
+        return None
+    try:
+        fitted = np.asarray(refit_outline(ring, tolerance), dtype=np.float64)
+    except InputError:
+        return None
+    return path_into_box(fitted, box)
 
 
 def refit_ring(ring: np.ndarray, tolerance: float, box: Box | None = None) -> np.ndarray:
     """A closed cubic path (3K, 2) within about ``tolerance`` px of the simple closed polygon
-    ``ring`` (N >= 3, not closed), itself simple, every control point inside ``box``."""
+    ``ring`` (N >= 3, not closed), itself simple, every control point inside ``box``: the
+    tracer's fit if it is simple, else the local fit, else a polygon path."""
     ring = np.asarray(ring, dtype=np.float64)
-    dense = _densify(ring)
-    cubics = _fit_stretches(dense, _corners(dense), tolerance)
-    path = _inside(cubics[:, :3].reshape(-1, 2), box)
-    if is_simple_path(path):
-        return path
+    fitted = _tracer_fit(ring, tolerance, box)
+    if fitted is not None and is_simple_path(fitted):
+        return fitted
+    fitted = _local_fit(ring, tolerance, box)
+    if is_simple_path(fitted):
+        return fitted
     return _polygon_path(ring, tolerance, box)
-
-
-def region_paths(
-    region: BaseGeometry, tolerance: float, min_area: float, box: Box | None = None
-) -> list[np.ndarray]:
-    """Closed cubic paths for the parts of a painted area (see ``outline_parts``), largest
-    first: the paths that replace one path whose area was repaired or clipped."""
-    return [refit_ring(ring, tolerance, box) for ring in outline_parts(region, min_area)]

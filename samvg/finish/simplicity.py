@@ -5,18 +5,21 @@ A path's flattened outline is checked with shapely (``LinearRing.is_simple``). A
 painted area (nonzero rule, ``outline.fill_region``) is split into its parts: the largest
 replaces the path, every other part of at least ``min_part_area`` px² becomes an extra path with
 the same paint right after it (the parts do not overlap, so their order among themselves does
-not matter), smaller ones are dropped; each part's outline is refitted with cubics
-(``refit.refit_ring``), which checks that the new path is simple.
+not matter), smaller ones (by their area on the canvas) are dropped; each part's outline is
+redrawn with the pieces of the path's own cubics it follows (``trim.redraw_ring``; a fresh fit
+if that is not simple).
 """
 
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
 from samvg.finish.edits import Edit, apply_edits
 from samvg.finish.flatten import flatten_paths
 from samvg.finish.outline import fill_region, simple_mask
-from samvg.finish.refit import Box, region_paths
+from samvg.finish.refit import Box
+from samvg.finish.trim import region_paths
 from samvg.scene import Scene
 
 #: Smallest area (px²) of a part split off a crossing path that is kept as its own path.
@@ -41,10 +44,13 @@ def simplify_paths(
     ``simple_dropped`` (crossing paths that painted no area worth a path)."""
     vertices, vertex_offsets = flatten_paths(scene.points, scene.offsets)
     crossing = np.flatnonzero(~simple_mask(vertices, vertex_offsets))
+    canvas = shapely.box(0.0, 0.0, scene.width, scene.height)
     edits: dict[int, Edit] = {}
     for index in crossing:
         ring = vertices[vertex_offsets[index] : vertex_offsets[index + 1]]
-        paths = region_paths(fill_region(ring), tolerance, min_part_area, box)
+        sources = [scene.path_points(int(index))]
+        region = fill_region(ring)
+        paths = region_paths(region, sources, tolerance, min_part_area, box, canvas)
         edits[int(index)] = [(points, scene.paints[index]) for points in paths]
     counts = {
         "simple_checked": scene.path_count,

@@ -53,6 +53,7 @@ from samvg.weights import (
     WeightSource,
     WeightSpec,
     cache_dir,
+    describe_load_error,
     download_weights,
     ensure_cache_folder,
     resolve_weights,
@@ -195,9 +196,8 @@ def _torch_load(path: Path, what: str) -> Mapping:
     try:
         obj = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # corrupt zip, truncated pickle, foreign objects: all the same to us
-        first = (str(e).splitlines() or [""])[0][:200]
         raise WeightsError(
-            f"cannot read {what} {path}: {type(e).__name__}: {first} (corrupt or truncated file?)"
+            f"cannot read {what} {path}: {describe_load_error(e)} (corrupt or truncated file?)"
         ) from None
     if not isinstance(obj, Mapping) or not all(
         isinstance(k, str) and isinstance(v, torch.Tensor) for k, v in obj.items()

@@ -19,7 +19,7 @@ from samvg.sam.model import Sam
 from samvg.sam.prompt_encoder import PromptEncoder
 from samvg.sam.tiny_vit import TinyViT
 from samvg.sam.transformer import TwoWayTransformer
-from samvg.weights import WeightSource, WeightSpec, resolve_weights
+from samvg.weights import WeightSource, WeightSpec, describe_load_error, resolve_weights
 
 ENV_VAR = "SAMVG_SAM_CHECKPOINT"
 
@@ -135,9 +135,8 @@ def read_checkpoint(path: str | os.PathLike[str]) -> dict[str, torch.Tensor]:
         KeyError,
         AttributeError,
     ) as e:
-        first = (str(e).splitlines() or [""])[0][:200]
         raise WeightsError(
-            f"cannot read SAM checkpoint {p}: {type(e).__name__}: {first}"
+            f"cannot read SAM checkpoint {p}: {describe_load_error(e)}"
             " (corrupt or truncated file? re-download it)"
         ) from None
     if isinstance(obj, Mapping) and "model" in obj and isinstance(obj["model"], Mapping):

@@ -133,7 +133,8 @@ def read_svg(text: str) -> ParsedSvg:
         _check_use_expansion(root)
         document = _parse_with_svgelements(root, geometry)
         scene = _Scene(geometry)
-        _read_group(document, scene, _opacity(document, 1.0, "svg"), use_label=None)
+        if document is not None:  # None: the root is not rendered (display:none), no shapes
+            _read_group(document, scene, _opacity(document, 1.0, "svg"), use_label=None)
     except RecursionError:
         raise InputError("svg: elements or <use> references are nested too deeply") from None
     return ParsedSvg(geometry.pixel_width, geometry.pixel_height, scene.background, scene.paths)
@@ -149,6 +150,8 @@ def _parse_xml(text: str) -> ElementTree.Element:
         raise InputError(f"not valid SVG/XML: {error}") from None
     if _local_name(root.tag) != "svg":
         raise InputError(f"root element is <{_local_name(root.tag)}>, expected <svg>")
+    if _is_foreign(root.tag):
+        raise InputError(f"root element {root.tag} is not in the SVG namespace ({_SVG_NAMESPACE})")
     _check_depth(root)
     return root
 

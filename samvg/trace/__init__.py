@@ -1,6 +1,11 @@
 """Stage 2: tracing segmentation masks into closed cubic Bézier paths (see ``tracer``)."""
 
-from samvg.trace.adaptive import DEFAULT_MAX_SEGMENTS, fit_adaptive, refit_outline
+from samvg.trace.adaptive import (
+    DEFAULT_MAX_SEGMENTS,
+    fit_adaptive,
+    refit_outline,
+    refit_outlines,
+)
 from samvg.trace.contour import find_components, mask_contour
 from samvg.trace.corners import find_corners, select_corners
 from samvg.trace.fit import fit_cubics
@@ -22,6 +27,7 @@ __all__ = [
     "fit_cubics",
     "mask_contour",
     "refit_outline",
+    "refit_outlines",
     "select_corners",
     "trace_components",
     "trace_masks",

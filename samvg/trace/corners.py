@@ -123,3 +123,35 @@ def fill_by_arclength(contour: np.ndarray, chosen: list[int], count: int) -> np.
             break
         corners = np.sort(np.append(corners, index))
     return corners
+
+
+def sharpen_corners(
+    contour: np.ndarray, corners: np.ndarray, reach: int = 4, limit: float = 1.0
+) -> np.ndarray:
+    """The contour with each corner point moved to where the straight runs on its two sides
+    meet (the chords over ``reach`` points before and after it), if that is within ``limit``
+    pixels: marching squares cut a pixel corner by a half-pixel diagonal, so a square's corner
+    join would sit half a pixel inside the corner and bend the sides' cubics towards it.
+    Corners too close to another corner for two points a side, or between almost parallel
+    runs, stay where they are."""
+    sharp = np.array(contour, dtype=np.float64)
+    total = len(contour)
+    if len(corners) == 0 or total < 5:
+        return sharp
+    gaps = np.diff(np.append(corners, corners[0] + total))
+    before = np.minimum(np.roll(gaps, 1) // 2, reach) if len(corners) > 1 else gaps * 0 + reach
+    after = np.minimum(gaps // 2, reach) if len(corners) > 1 else gaps * 0 + reach
+    for corner, back, ahead in zip(corners.tolist(), before.tolist(), after.tolist(), strict=True):
+        if min(back, ahead) < 2:
+            continue
+        a0, a1 = contour[(corner - back) % total], contour[(corner - 1) % total]
+        b0, b1 = contour[(corner + 1) % total], contour[(corner + ahead) % total]
+        u, v = a1 - a0, b1 - b0
+        cross = u[0] * v[1] - u[1] * v[0]
+        if abs(cross) < 0.1 * np.hypot(*u) * np.hypot(*v):  # within ~6° of parallel
+            continue
+        w = b0 - a0
+        meet = a0 + u * (w[0] * v[1] - w[1] * v[0]) / cross
+        if np.hypot(*(meet - contour[corner])) <= limit:
+            sharp[corner] = meet
+    return sharp

@@ -46,13 +46,13 @@ def densify(contour: np.ndarray, minimum: int) -> np.ndarray:
 
 
 def stretch_samples(
-    starts: np.ndarray, lengths: np.ndarray, totals: np.ndarray
+    starts: np.ndarray, lengths: np.ndarray, totals: np.ndarray, most: int = MAX_FIT_POINTS
 ) -> tuple[np.ndarray, np.ndarray]:
     """The points fitted for each stretch of a closed contour: stretch j runs ``lengths[j]``
     steps forward from index ``starts[j]`` of a contour of ``totals[j]`` points (both ends
     included; a whole loop returns to its start). Returns, concatenated, the contour indices of
-    at most ``MAX_FIT_POINTS`` points evenly spread along each stretch, and each one's count."""
-    sizes = np.clip(lengths + 1, 2, MAX_FIT_POINTS)  # a zero-length stretch: a point cubic
+    at most ``most`` points evenly spread along each stretch, and each one's count."""
+    sizes = np.clip(lengths + 1, 2, most)  # a zero-length stretch: a point cubic
     first = np.cumsum(sizes) - sizes
     step = np.arange(int(sizes.sum())) - np.repeat(first, sizes)
     scale = np.repeat(lengths / np.maximum(sizes - 1, 1), sizes)

@@ -8,15 +8,21 @@ import numpy as np
 
 from samvg.config import Config
 from samvg.scene import RGB, Scene
+from samvg.trace.adaptive import DEFAULT_MAX_SEGMENTS
 from samvg.trace.tracer import trace_masks
 
 
 @dataclass(frozen=True)
 class TraceSettings:
-    """Stage 2 in working pixels (derived once from `Config` for one canvas)."""
+    """Stage 2 in working pixels (derived once from `Config` for one canvas).
+
+    ``segments``: cubics per path, used when ``tolerance`` is None; ``tolerance`` (pixels):
+    each path gets the fewest segments (at most ``max_segments``) that fit within it."""
 
     segments: int
     min_pixels: float
+    tolerance: float | None = None
+    max_segments: int = DEFAULT_MAX_SEGMENTS
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> TraceSettings:
@@ -38,5 +44,10 @@ def uncovered_background(masks: list[np.ndarray], target: np.ndarray) -> RGB:
 def trace_scene(masks: list[np.ndarray], target: np.ndarray, settings: TraceSettings) -> Scene:
     """Every component of every mask as a path filled with its mean colour (no background)."""
     return trace_masks(
-        masks, target, segments_per_path=settings.segments, min_area=settings.min_pixels
+        masks,
+        target,
+        segments_per_path=settings.segments,
+        min_area=settings.min_pixels,
+        tolerance=settings.tolerance,
+        max_segments=settings.max_segments,
     )

@@ -29,13 +29,13 @@ import numpy as np
 from samvg.errors import InputError
 from samvg.imaging import to_float_rgb
 from samvg.scene import FlatPaint, Scene
-from samvg.trace.contour import Components, find_components
 from samvg.trace.adaptive import (
     DEFAULT_MAX_SEGMENTS,
     check_max_segments,
     check_tolerance,
     fit_adaptive,
 )
+from samvg.trace.contour import Components, find_components
 from samvg.trace.outline import fit_fixed
 
 #: Default smallest component kept, in pixels (a 4 × 4 block): smaller specks would cost a whole
@@ -48,9 +48,11 @@ class TracedPath:
     """One traced component.
 
     ``points`` (3K, 2): the closed path in :class:`~samvg.scene.Scene` layout, starting at a
-    corner (K is the same for every path unless a tolerance chose it). ``mask_index``: index of the source mask. ``area``: pixel count of the component
-    (holes not counted). ``max_error`` / ``rms_error``: max and RMS distance in pixels between the
-    contour points and the fitted curve (each point to its Newton-refined parameter's point).
+    corner; K is ``segments_per_path`` for every path, or each path's own count when a
+    tolerance chose it. ``mask_index``: index of the source mask. ``area``: pixel count of the
+    component (holes not counted). ``max_error`` / ``rms_error``: max and RMS distance in pixels
+    between the fitted contour points and the curve (each point to its Newton-refined
+    parameter's point).
     """
 
     points: np.ndarray
@@ -137,7 +139,7 @@ def _trace(
     if tolerance is None:
         fits = fit_fixed(contours, segments)
     else:
-        fits = fit_adaptive(contours, tolerance, cap)
+        fits = fit_adaptive(contours, tolerance, cap, sharpen=True)
     traced = [
         TracedPath(fit.points, mask_index, area, fit.max_error, fit.rms_error)
         for fit, mask_index, area in zip(fits, owners, areas, strict=True)

@@ -280,27 +280,9 @@ def test_hundred_masks_at_512_px_are_fast():
     assert elapsed < 2.0  # typically ~0.2 s; generous for a shared machine
 
 
-@pytest.fixture
-def one_torch_thread():
-    """SAM on one thread: on the shared 2-core machine two threads stall each other (~3x)."""
-    import torch
-
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
 @pytest.mark.slow
-def test_real_sam_masks(sam_checkpoint, bench_dir, one_torch_thread):
-    from samvg.sam import SamAutomaticMaskGenerator, load_sam
-
-    photo = Image.open(bench_dir / "photo" / "kodim04.png").convert("RGB")
-    photo.thumbnail((256, 256))
-    image = np.asarray(photo)
-    model = load_sam("mobile_sam", checkpoint=sam_checkpoint)
-    records = SamAutomaticMaskGenerator(model, points_per_side=12).generate(image)
-    masks = sorted((r["segmentation"] for r in records), key=lambda m: -int(m.sum()))
+def test_real_sam_masks(photo_sam_masks):
+    image, masks = photo_sam_masks
     assert len(masks) >= 5
     result, info = trace_masks_with_info(masks, image, segments_per_path=4)
     height, width = image.shape[:2]

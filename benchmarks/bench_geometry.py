@@ -1,0 +1,224 @@
+"""Clean geometry on the bench (issue 12): self-intersecting paths, control points outside the
+canvas, translucent fills, parameters per path, SVG bytes, MSE and LPIPS; the default settings
+against fixed 5 segments per path at the same path count.
+
+    python benchmarks/bench_geometry.py --out runs/geometry            # all 75 images, resumes
+    python benchmarks/bench_geometry.py --out runs/geometry --per-category 4
+    python benchmarks/bench_geometry.py --out runs/geometry --report-only
+
+Each image's result is a JSON file in ``--out`` (a rerun skips what is there), and the report
+goes to ``benchmarks/results/geometry.md``. The checks are independent of the finish pass: every
+output path is flattened and tested with shapely in the SVG's own (input) pixels.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import time
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import shapely
+
+import samvg
+from samvg.imaging import resize_longest, to_float_rgb
+from samvg.io import atomic_write_text, read_image
+from samvg.metrics import load_lpips, lpips_distance
+from samvg.scene import Scene
+
+REPO = Path(__file__).resolve().parents[1]
+BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
+OUTSIDE_FRACTION = 0.05
+CURVE_SAMPLES = 24
+
+
+def outline(points: np.ndarray) -> np.ndarray:
+    """A closed path's outline, each cubic sampled at CURVE_SAMPLES parameters."""
+    count = len(points)
+    t = np.linspace(0.0, 1.0, CURVE_SAMPLES, endpoint=False)[:, None]
+    pieces = []
+    for k in range(count // 3):
+        p0, p1, p2 = points[3 * k], points[3 * k + 1], points[3 * k + 2]
+        p3 = points[(3 * k + 3) % count]
+        s = 1.0 - t
+        pieces.append(s**3 * p0 + 3 * s * s * t * p1 + 3 * s * t * t * p2 + t**3 * p3)
+    return np.concatenate(pieces)
+
+
+def geometry_checks(scene: Scene, opaque_input: bool) -> dict[str, Any]:
+    """Counts of self-intersecting paths, points far outside the canvas, translucent fills."""
+    margin = OUTSIDE_FRACTION * max(scene.width, scene.height)
+    low, high = -margin, np.array([scene.width + margin, scene.height + margin])
+    crossing = outside_points = outside_paths = 0
+    for points, _paint in scene.paths():
+        ring = outline(points)
+        if (
+            len(np.unique(np.round(ring, 6), axis=0)) >= 3
+            and not shapely.LinearRing(ring).is_simple
+        ):
+            crossing += 1
+        far = np.any((points < low) | (points > high), axis=1)
+        outside_points += int(far.sum())
+        outside_paths += int(far.any())
+    translucent = sum(paint.rgba[3] < 1.0 for paint in scene.paints)
+    counts = scene.segment_counts()
+    return {
+        "paths": scene.path_count,
+        "self_intersecting": crossing,
+        "outside_points": outside_points,
+        "outside_paths": outside_paths,
+        "translucent": int(translucent) if opaque_input else None,
+        "segments_mean": float(counts.mean()) if len(counts) else 0.0,
+        "parameters": scene.parameter_count,
+    }
+
+
+def run_one(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dict[str, Any]:
+    original = read_image(BENCH / entry["png"])
+    working, scale = resize_longest(original, config.size)
+    target = to_float_rgb(working)
+    started = time.perf_counter()
+    result = samvg.run(original, config)
+    seconds = time.perf_counter() - started
+    render = np.clip(result.image.render(scale=scale)[: target.shape[0], : target.shape[1]], 0, 1)
+    record = geometry_checks(result.image.scene, opaque_input=True)
+    record.update(
+        id=entry["id"],
+        category=entry["category"],
+        svg_bytes=len(result.image.to_svg().encode()),
+        mse=float(np.mean((render - target) ** 2)),
+        lpips=lpips_distance(lpips, render, target),
+        seconds=seconds,
+    )
+    return record
+
+
+def configs(name: str, paths: int | None) -> samvg.Config:
+    if name == "default":
+        return samvg.Config()
+    if name == "fixed5":
+        return samvg.Config(segments=5, max_paths=paths)
+    raise SystemExit(f"unknown setting {name!r}")
+
+
+def chosen_entries(per_category: int | None) -> list[dict[str, str]]:
+    with open(BENCH / "manifest.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    if per_category is None:
+        return rows
+    picked: dict[str, list[dict[str, str]]] = defaultdict(list)
+    for row in rows:
+        if len(picked[row["category"]]) < per_category:
+            picked[row["category"]].append(row)
+    return [row for category in sorted(picked) for row in picked[category]]
+
+
+def run_all(entries: list[dict[str, str]], out: Path, names: list[str]) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    lpips = load_lpips()
+    for entry in entries:
+        for name in names:
+            record_file = out / f"{entry['id']}.{name}.json"
+            if record_file.exists():
+                continue
+            paths = None
+            if name != "default":
+                reference = out / f"{entry['id']}.default.json"
+                if not reference.exists():
+                    continue
+                paths = json.loads(reference.read_text())["paths"]
+            record = run_one(entry, configs(name, paths), lpips)
+            record["setting"] = name
+            atomic_write_text(record_file, json.dumps(record, indent=1))
+            print(json.dumps(record), flush=True)
+
+
+def _table(records: list[dict[str, Any]], names: list[str]) -> list[str]:
+    lines = [
+        "| category | setting | images | paths | segments/path | parameters/path | SVG bytes | "
+        "MSE ×1e-3 | LPIPS | self-intersecting | points >5% outside | translucent | s/image |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = defaultdict(list)
+    for record in records:
+        groups[(record["category"], record["setting"])].append(record)
+        groups[("all", record["setting"])].append(record)
+    categories = sorted({category for category, _ in groups} - {"all"}) + ["all"]
+    for category in categories:
+        for name in names:
+            rows = groups.get((category, name))
+            if not rows:
+                continue
+            per_path = sum(r["parameters"] for r in rows) / max(sum(r["paths"] for r in rows), 1)
+
+            def mean(key: str, rows: list[dict[str, Any]] = rows) -> float:
+                return float(np.mean([r[key] for r in rows]))
+
+            lines.append(
+                f"| {category} | {name} | {len(rows)} | {mean('paths'):.1f} | "
+                f"{mean('segments_mean'):.2f} | {per_path:.1f} | "
+                f"{mean('svg_bytes'):.0f} | {1e3 * mean('mse'):.2f} | {mean('lpips'):.3f} | "
+                f"{sum(r['self_intersecting'] for r in rows)} | "
+                f"{sum(r['outside_points'] for r in rows)} | "
+                f"{sum(r['translucent'] or 0 for r in rows)} | {mean('seconds'):.1f} |"
+            )
+    return lines
+
+
+def write_report(out: Path, names: list[str], report: Path) -> None:
+    records = [json.loads(p.read_text()) for p in sorted(out.glob("*.json"))]
+    records = [r for r in records if r["setting"] in names]
+    ids = {r["id"] for r in records if r["setting"] == "default"}
+    paired = [r for r in records if r["id"] in ids]
+    lines = [
+        "# Clean geometry (issue 12)",
+        "",
+        "`python benchmarks/bench_geometry.py --out OUT` on `../shared/bench` at 512 px. "
+        "*default*: the product default (adaptive segments, opaque fills, bounded points, finish "
+        "pass). *fixed5*: the same with 5 segments per path and `--max-paths` set to the "
+        "default's path count. Counts are totals over the images; other columns are means. "
+        "Self-intersection is tested with shapely on each output path's outline "
+        f"({CURVE_SAMPLES} samples per cubic); outside = more than "
+        f"{OUTSIDE_FRACTION:.0%} of the longer side beyond the canvas.",
+        "",
+        *_table(paired, names),
+    ]
+    wins = defaultdict(int)
+    by_id: dict[str, dict[str, dict[str, Any]]] = defaultdict(dict)
+    for record in paired:
+        by_id[record["id"]][record["setting"]] = record
+    both = [v for v in by_id.values() if "default" in v and "fixed5" in v]
+    for pair in both:
+        wins["mse"] += pair["default"]["mse"] <= pair["fixed5"]["mse"]
+        wins["lpips"] += pair["default"]["lpips"] <= pair["fixed5"]["lpips"]
+    if both:
+        lines += [
+            "",
+            f"Default against fixed5 on {len(both)} images: MSE lower or equal on "
+            f"{wins['mse']}, LPIPS lower or equal on {wins['lpips']}.",
+        ]
+    atomic_write_text(report, "\n".join(lines) + "\n")
+    print(f"wrote {report}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--per-category", type=int)
+    parser.add_argument("--settings", default="default,fixed5")
+    parser.add_argument("--report", type=Path, default=REPO / "benchmarks/results/geometry.md")
+    parser.add_argument("--report-only", action="store_true")
+    arguments = parser.parse_args()
+    names = arguments.settings.split(",")
+    if not arguments.report_only:
+        run_all(chosen_entries(arguments.per_category), arguments.out, names)
+    write_report(arguments.out, names, arguments.report)
+
+
+if __name__ == "__main__":
+    main()

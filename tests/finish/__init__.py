@@ -1,0 +1,1 @@
+"""Tests of samvg.finish, the last stage before saving: simple, bounded, visible, merged paths."""
