@@ -279,6 +279,48 @@ def main() -> None:
     write_report(args, rows, alternative, pictures, shapes, time.perf_counter() - started)
 
 
+def reading(rows: list[Row], alternative: Row) -> str:
+    """What the tables say, with this run's numbers."""
+    by = {row.label: row for row in rows}
+
+    def stats(label: str) -> str:
+        row = by[label]
+        return (
+            f"{np.mean(row.counts):.1f} segments, {6 * np.mean(row.counts) + 4:.0f} parameters "
+            f"a path, mean IoU {np.mean(row.ious):.3f}, pooled {row.inter / row.union:.4f}"
+        )
+
+    def beaten(label: str) -> str:
+        """The fixed-K settings the tolerance beats on pooled IoU."""
+        pooled = by[label].inter / by[label].union
+        fixed = [f"K={k}" for k in FIXED if by[f"K={k}"].inter / by[f"K={k}"].union < pooled]
+        return ", ".join(fixed) or "none"
+
+    tol1, alt = by["tol 1"], alternative
+    return (
+        f"* tol 1: {stats('tol 1')}; K=5: {stats('K=5')}; K=8: {stats('K=8')}. On pooled IoU "
+        f"(pixels) 1 px beats {beaten('tol 1')} at about the parameters of K=5-6: the segments "
+        "go to the long, complex outlines. Per path (mean IoU) it is close to K=5: small masks "
+        "get 2-3 segments, and 1 px is a lot for a mask 15 px across (a boundary pixel's "
+        "centre lies within 0.5 px of the contour, so a 0.5 px shift flips it).\n"
+        f"* tol 0.5: {stats('tol 0.5')}: about twice the parameters of 1 px for the last "
+        "half-percent; at 0.5 px and below the fit starts to follow the pixel staircase (the "
+        "disk in the synthetic table).\n"
+        f"* tol 2: {stats('tol 2')} (beats {beaten('tol 2')} on pooled IoU); tol 3: "
+        f"{stats('tol 3')} (beats {beaten('tol 3')}). Coarse tolerances lose the small shapes "
+        "first (mean IoU).\n"
+        f"* Re-selecting corners at each K needs {np.mean(alt.counts):.2f} segments a path for "
+        f"the same tolerance (tol 1: {np.mean(tol1.counts):.2f}) and "
+        f"{alt.seconds / max(tol1.seconds, 1e-9):.0f}x the time: growing by splits keeps joins "
+        "that already fit, and the merge pass removes the ones the greedy splits did not "
+        "need.\n"
+        "* Measured while developing (not rerun here): splitting at the worst point or at the "
+        "arclength middle gives the same counts within 2 %; the merge pass saves about 5 % of "
+        "the segments; sliding joins to lower the error changed IoU by < 0.001 for 2x the "
+        "time, so the tracer does not do it."
+    )
+
+
 def write_report(
     args: argparse.Namespace,
     rows: list[Row],
@@ -310,6 +352,8 @@ def write_report(
         "it. Compare with the `tol 1` row above (split at the worst point, merge, corners "
         "kept).\n\n"
         f"{summary_table([alternative])}\n\n"
+        "## Reading\n\n"
+        f"{reading(rows, alternative)}\n\n"
         "## Synthetic shapes: segments (max error px) at each tolerance\n\n"
         "128x128 masks from `tests/trace/synthetic.py`; the disc is 128x96.\n\n"
         f"{shapes}\n"

@@ -2,8 +2,9 @@
 
 Bounded control points (``bounds``), simple paths (``simplicity``), no hidden paths
 (``hidden``), merged paths of near-equal colour (``merge``) and an optional palette
-(``palette``), on polygons from one flattener (``flatten``), with outlines refitted by
-``refit``.
+(``palette``). They share one flattener (``flatten``), the painted area of a path as shapely
+geometry (``outline``), outlines redrawn from the cubics they were cut from (``trim``) or fitted
+afresh (``refit``), cubic-segment operations (``cubics``) and per-path scene edits (``edits``).
 """
 
 from samvg.finish.bounds import bound_paths, default_margin, margin_box
@@ -14,6 +15,7 @@ from samvg.finish.merge import merge_paths
 from samvg.finish.palette import snap_colours
 from samvg.finish.refit import refit_ring
 from samvg.finish.simplicity import crossing_paths, simplify_paths
+from samvg.finish.trim import redraw_ring
 
 __all__ = [
     "FinishResult",
@@ -26,6 +28,7 @@ __all__ = [
     "flatten_paths",
     "margin_box",
     "merge_paths",
+    "redraw_ring",
     "refit_ring",
     "remove_hidden",
     "simplify_paths",

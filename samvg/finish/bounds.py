@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from shapely.geometry.base import BaseGeometry
 
+from samvg.finish.cubics import Box
 from samvg.finish.edits import Edit, apply_edits
 from samvg.finish.flatten import flatten_paths
-from samvg.finish.outline import DEGENERATE_AREA, fill_region
-from samvg.finish.refit import Box
+from samvg.finish.outline import DEGENERATE_AREA, fill_region, filled_holes
 from samvg.finish.trim import region_paths
 from samvg.scene import Scene
 
@@ -60,6 +61,23 @@ def _off_canvas(vertices: np.ndarray, vertex_offsets: np.ndarray, scene: Scene) 
     )
 
 
+def _clipped(
+    region: BaseGeometry,
+    source: np.ndarray,
+    box: Box,
+    canvas: BaseGeometry,
+    tolerance: float,
+    min_part_area: float,
+) -> tuple[list[np.ndarray], int]:
+    """The paths for a painted area clipped to the box (none if it misses the canvas), and
+    how many holes they fill."""
+    if shapely.intersection(region, canvas).area < DEGENERATE_AREA:
+        return [], 0
+    clipped = shapely.intersection(region, shapely.box(*box))
+    paths = region_paths(clipped, [source], tolerance, min_part_area, box, canvas)
+    return paths, filled_holes(clipped) if paths else 0
+
+
 def bound_paths(
     scene: Scene,
     margin: float | None = None,
@@ -67,33 +85,29 @@ def bound_paths(
     min_part_area: float = 4.0,
 ) -> tuple[Scene, dict[str, int]]:
     """Clip every path reaching beyond the canvas plus ``margin`` px (default
-    :func:`default_margin`) to that box, refitted within ``tolerance`` px. Counts:
-    ``bounds_checked``, ``bounds_clipped`` (paths replaced by clipped ones), ``bounds_split``
-    (extra paths from clipping), ``bounds_dropped`` (paths painting nothing on the canvas)."""
+    :func:`default_margin`) to that box, redrawn (fitted within ``tolerance`` px where new).
+    Counts: ``bounds_checked``, ``bounds_clipped`` (paths replaced by clipped ones),
+    ``bounds_split`` (extra paths from clipping), ``bounds_dropped`` (paths painting nothing
+    on the canvas), ``bounds_holes_filled`` (holes of clipped crossing paths painted over)."""
     if margin is None:
         margin = default_margin(scene.width, scene.height)
     box = margin_box(scene.width, scene.height, margin)
     canvas = shapely.box(0.0, 0.0, scene.width, scene.height)
     vertices, vertex_offsets = flatten_paths(scene.points, scene.offsets)
-    outside = _outside(scene.points, scene.offsets, box)
-    edits: dict[int, Edit] = {
-        int(i): [] for i in np.flatnonzero(_off_canvas(vertices, vertex_offsets, scene))
-    }
-    for index in np.flatnonzero(outside):
-        if int(index) in edits:
-            continue
+    off_canvas = _off_canvas(vertices, vertex_offsets, scene)
+    edits: dict[int, Edit] = {int(index): [] for index in np.flatnonzero(off_canvas)}
+    holes = 0
+    for index in np.flatnonzero(_outside(scene.points, scene.offsets, box) & ~off_canvas):
         region = fill_region(vertices[vertex_offsets[index] : vertex_offsets[index + 1]])
-        if shapely.intersection(region, canvas).area < DEGENERATE_AREA:
-            edits[int(index)] = []
-            continue
-        clipped = shapely.intersection(region, shapely.box(*box))
-        sources = [scene.path_points(int(index))]
-        paths = region_paths(clipped, sources, tolerance, min_part_area, box, canvas)
+        source = scene.path_points(int(index))
+        paths, filled = _clipped(region, source, box, canvas, tolerance, min_part_area)
         edits[int(index)] = [(points, scene.paints[index]) for points in paths]
+        holes += filled
     counts = {
         "bounds_checked": scene.path_count,
         "bounds_clipped": sum(1 for edit in edits.values() if edit),
         "bounds_split": sum(max(len(edit) - 1, 0) for edit in edits.values()),
         "bounds_dropped": sum(1 for edit in edits.values() if not edit),
+        "bounds_holes_filled": holes,
     }
     return apply_edits(scene, edits), counts

@@ -2,8 +2,8 @@
 
 ``finish_scene`` runs, in order: bounded geometry (``bounds``), simple paths (``simplicity``),
 hidden paths (``hidden``), merging (``merge``) and the palette (``palette``), each switchable in
-:class:`FinishSettings`, and adds up their counts. Every refitted path keeps its control points
-inside the canvas plus the margin.
+:class:`FinishSettings` (bounds always runs), and gathers their counts. Every path a step
+redraws keeps its control points inside the canvas plus the margin.
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ class FinishSettings:
     """What the finish stage does, in working pixels.
 
     ``margin``: how far (px) control points may lie outside the canvas; None: 2 % of the longer
-    side. ``tolerance``: largest distance (px) of a refitted outline from the area it redraws.
+    side. ``tolerance``: largest distance (px) of an outline fitted afresh from the area it
+    redraws (outlines cut from existing paths keep those paths' cubics and need no fit).
     ``merge_delta_e``: largest CIELAB ΔE of two fills that merge. ``colours``: snap the fills to
     this many colours (None: keep them). ``min_part_area``: smallest part (px²) split off a
     crossing or clipped path kept as its own path. ``hidden_tolerance``: uncovered area (px²) a

@@ -10,7 +10,7 @@ point) and their union is one polygon without holes (a gap under ``MERGE_DISTANC
 by a mitred buffer out and back) and, for translucent fills, when
 they do not overlap. The merged path takes the upper one's place, the union's outline redrawn from
 the two paths' cubics (``trim.redraw_ring``; fitted afresh where a gap was closed), or the path
-that already contains the other, and the area-weighted mean fill.
+that already contains the other, and the mean fill weighted by the area of each that shows.
 Each path merges at most once per round; rounds repeat until nothing merges.
 """
 
@@ -23,9 +23,9 @@ import shapely
 from shapely.geometry.base import BaseGeometry
 from skimage.color import rgb2lab
 
+from samvg.finish.cubics import Box
 from samvg.finish.flatten import flatten_path, flatten_paths
 from samvg.finish.outline import path_regions
-from samvg.finish.refit import Box
 from samvg.finish.trim import redraw_ring
 from samvg.scene import FlatPaint, Paint, Scene
 
@@ -131,7 +131,8 @@ def _merge_pair(paths: _Paths, lower: int, upper: int, tolerance: float, box: Bo
         ring = np.asarray(outline.exterior.coords)[:-1]
         sources = [] if closed else [paths.points[lower], paths.points[upper]]
         points = redraw_ring(ring, sources, tolerance, box)
-    weights = np.array([first.area, second.area]) + 1e-9
+    # Each fill weighs what of it shows: the lower one only outside the upper one.
+    weights = np.array([shapely.difference(first, second).area, second.area]) + 1e-9
     rgba = np.array([paths.paints[lower].rgba, paths.paints[upper].rgba])
     paths.paints[upper] = FlatPaint(tuple(np.clip(weights @ rgba / weights.sum(), 0.0, 1.0)))
     paths.points[upper] = points

@@ -114,6 +114,12 @@ def outline_parts(
     return [np.asarray(shells[index].exterior.coords)[:-1] for index in kept]
 
 
+def filled_holes(geometry: BaseGeometry) -> int:
+    """How many holes of at least ``DEGENERATE_AREA`` px² ``outline_parts`` fills."""
+    holes = [shapely.Polygon(ring) for part in _polygons_in(geometry) for ring in part.interiors]
+    return sum(1 for hole in holes if hole.area >= DEGENERATE_AREA)
+
+
 def path_regions(vertices: np.ndarray, vertex_offsets: np.ndarray) -> np.ndarray:
     """(P,) object array: the painted area of every polygon (see :func:`fill_region`)."""
     simple = simple_mask(vertices, vertex_offsets)

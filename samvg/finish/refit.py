@@ -1,14 +1,17 @@
-"""Outlines (closed polygons) back into closed cubic paths: corners, least-squares cubics,
-split where the error is too large; the result is checked to be simple and kept in a box.
+"""Outlines (closed polygons) back into closed cubic paths, checked to be simple and kept in a
+box: for outlines that follow no existing path (``trim`` redraws those that do).
 
-The local fitter for the finish stage (``samvg.trace`` has no outline refitter yet): the ring is
+Two fits are made and the simple one with fewer segments is kept: the tracer's, by
+``samvg.trace.refit_outline`` (looked up at call time: it is new in the tracer) with any segment
+sticking out of the box subdivided into it, and the local fitter's. The local fitter: the ring is
 densified to points at most ``STEP`` px apart (its vertices kept), cut at corners (points where
 the outline turns by at least ``CORNER_DEGREES`` between the points ``REACH`` px behind and
-ahead, strongest first, at most one per ``REACH``), and every stretch between two corners is
-fitted with one cubic by ``samvg.trace.fit.fit_cubics``; a stretch whose points stray more than
-the tolerance from its cubic is split at its worst point and both halves are fitted again
-(Schneider's recursion, all stretches of a round in one batch). If the path this gives crosses
-itself, the outline becomes a polygon path instead: the ring simplified within the tolerance
+ahead, strongest first, at most one per ``REACH``, and where it starts or stops running along the
+box's border), and every stretch between two corners is fitted with one cubic by
+``samvg.trace.fit.fit_cubics``; a stretch whose points stray more than the tolerance from its
+cubic, or whose control points leave the box, is split at its worst point and both halves are
+fitted again (Schneider's recursion, all stretches of a round in one batch). If both paths
+cross themselves, the outline becomes a polygon path: the ring simplified within the tolerance
 (topology kept), each edge a straight cubic with handles at its thirds.
 """
 
@@ -18,7 +21,6 @@ import numpy as np
 import shapely
 
 from samvg import trace
-from samvg.errors import InputError
 from samvg.finish.cubics import Box, clip_points, path_into_box, straight_path
 from samvg.finish.flatten import flatten_path
 from samvg.finish.outline import simple_mask
@@ -161,20 +163,18 @@ def _tracer_fit(ring: np.ndarray, tolerance: float, box: Box | None) -> np.ndarr
         return None
     try:
         fitted = np.asarray(refit_outline(ring, tolerance), dtype=np.float64)
-    except InputError:
+    except ValueError:  # InputError included: a ring the tracer cannot fit
         return None
     return path_into_box(fitted, box)
 
 
 def refit_ring(ring: np.ndarray, tolerance: float, box: Box | None = None) -> np.ndarray:
     """A closed cubic path (3K, 2) within about ``tolerance`` px of the simple closed polygon
-    ``ring`` (N >= 3, not closed), itself simple, every control point inside ``box``: the
-    tracer's fit if it is simple, else the local fit, else a polygon path."""
+    ``ring`` (N >= 3, not closed), itself simple, every control point inside ``box``: of the
+    tracer's fit and the local fit, the simple one with fewer segments, else a polygon path."""
     ring = np.asarray(ring, dtype=np.float64)
-    fitted = _tracer_fit(ring, tolerance, box)
-    if fitted is not None and is_simple_path(fitted):
-        return fitted
-    fitted = _local_fit(ring, tolerance, box)
-    if is_simple_path(fitted):
-        return fitted
+    fits = [_tracer_fit(ring, tolerance, box), _local_fit(ring, tolerance, box)]
+    simple = [fit for fit in fits if fit is not None and is_simple_path(fit)]
+    if simple:
+        return min(simple, key=len)
     return _polygon_path(ring, tolerance, box)

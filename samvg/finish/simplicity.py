@@ -15,10 +15,10 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from samvg.finish.cubics import Box
 from samvg.finish.edits import Edit, apply_edits
 from samvg.finish.flatten import flatten_paths
-from samvg.finish.outline import fill_region, simple_mask
-from samvg.finish.refit import Box
+from samvg.finish.outline import fill_region, filled_holes, simple_mask
 from samvg.finish.trim import region_paths
 from samvg.scene import Scene
 
@@ -41,15 +41,19 @@ def simplify_paths(
     """Replace every crossing path by simple ones (refitted within ``tolerance`` px, control
     points inside ``box`` if given). Counts: ``simple_checked`` (paths), ``simple_repaired``
     (crossing paths replaced), ``simple_split`` (extra paths added by splits),
-    ``simple_dropped`` (crossing paths that painted no area worth a path)."""
+    ``simple_dropped`` (crossing paths that painted no area worth a path),
+    ``simple_holes_filled`` (holes, areas a crossing path loops round without painting, that
+    its simple outlines paint over)."""
     vertices, vertex_offsets = flatten_paths(scene.points, scene.offsets)
     crossing = np.flatnonzero(~simple_mask(vertices, vertex_offsets))
     canvas = shapely.box(0.0, 0.0, scene.width, scene.height)
     edits: dict[int, Edit] = {}
+    holes = 0
     for index in crossing:
         ring = vertices[vertex_offsets[index] : vertex_offsets[index + 1]]
         sources = [scene.path_points(int(index))]
         region = fill_region(ring)
+        holes += filled_holes(region)
         paths = region_paths(region, sources, tolerance, min_part_area, box, canvas)
         edits[int(index)] = [(points, scene.paints[index]) for points in paths]
     counts = {
@@ -57,5 +61,6 @@ def simplify_paths(
         "simple_repaired": sum(1 for edit in edits.values() if edit),
         "simple_split": sum(max(len(edit) - 1, 0) for edit in edits.values()),
         "simple_dropped": sum(1 for edit in edits.values() if not edit),
+        "simple_holes_filled": holes,
     }
     return apply_edits(scene, edits), counts

@@ -8,8 +8,8 @@ as the piece of the source's cubic between the two parameters (de Casteljau), so
 geometry keeps its exact curves and segments. Edges that follow no source (the margin box's
 border, for instance) become straight cubics. The ends of every piece are moved onto the
 outline's vertices (by at most the flattening tolerance), so pieces join exactly. A cubic with a
-control point outside the box is subdivided until it is inside (the last bit is clipped). If
-the path this gives is not simple, or the outline follows no source at all, the outline is
+control point outside the box is subdivided until it is inside (the last bit is clipped). If the
+path this gives is not simple, or the outline follows no source at all, the outline is
 fitted afresh (``refit.refit_ring``); so is an outline whose pieces are mostly new straight edges
 (more than ``MAX_LINES`` of them).
 """
@@ -22,9 +22,9 @@ import numpy as np
 import shapely
 from shapely.geometry.base import BaseGeometry
 
+from samvg.finish.cubics import Box, into_box, path_of, straight_path, sub_cubic
 from samvg.finish.flatten import flatten, segment_ends
 from samvg.finish.outline import outline_parts
-from samvg.finish.cubics import Box, into_box, path_of, straight_path, sub_cubic
 from samvg.finish.refit import is_simple_path, refit_ring
 
 #: Distance (px) within which an outline vertex lies on a source chord.
@@ -132,8 +132,8 @@ def _assemble(
             cubic = sub_cubic(sources.cubic(segment), t_from, t_to)
             cubic[:2] += start - cubic[0]
             cubic[2:] += end - cubic[3]
-        cubics.extend(into_box(cubic, box))
-    return path_of(cubics)
+        cubics.append(cubic)
+    return path_of([piece for cubic in cubics for piece in into_box(cubic, box)])
 
 
 def redraw_ring(

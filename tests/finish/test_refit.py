@@ -2,11 +2,14 @@
 least-squares fit otherwise; both simple and inside the box."""
 
 import numpy as np
+import pytest
 import shapely
 
+import samvg.trace
+from samvg.finish.cubics import sub_cubic
 from samvg.finish.flatten import FLATTEN_TOLERANCE, flatten_path
-from samvg.finish.refit import refit_ring, straight_path
-from samvg.finish.trim import redraw_ring, sub_cubic
+from samvg.finish.refit import refit_ring
+from samvg.finish.trim import redraw_ring
 from tests.finish.shapes import ellipse, figure_eight, is_simple
 
 
@@ -43,7 +46,17 @@ def test_sub_cubic_pieces_join_into_the_whole_cubic():
     assert np.allclose(backwards[::-1], sub_cubic(cubic, 0.2, 0.7))
 
 
-def test_a_fresh_fit_of_a_circle_needs_few_cubics_within_the_tolerance():
+@pytest.fixture(params=["tracer", "local"])
+def fitter(request, monkeypatch):
+    """Fresh fits by the tracer's ``refit_outline``, and by the local fitter without it."""
+    if request.param == "local":
+        monkeypatch.delattr(samvg.trace, "refit_outline", raising=False)
+    elif not hasattr(samvg.trace, "refit_outline"):
+        pytest.skip("samvg.trace has no refit_outline")
+    return request.param
+
+
+def test_a_fresh_fit_of_a_circle_needs_few_cubics_within_the_tolerance(fitter):
     angles = np.linspace(0, 2 * np.pi, 400, endpoint=False)
     ring = np.stack([200 + 60 * np.cos(angles), 200 + 60 * np.sin(angles)], 1)
     path = refit_ring(ring, tolerance=0.5)
@@ -53,13 +66,15 @@ def test_a_fresh_fit_of_a_circle_needs_few_cubics_within_the_tolerance():
     assert shapely.distance(drawn, shapely.points(ring)).max() < 0.5
 
 
-def test_a_fresh_fit_keeps_square_corners_and_straight_sides():
+def test_a_fresh_fit_keeps_square_corners_and_straight_sides(fitter):
     square = np.array([[10, 10], [110, 10], [110, 110], [10, 110]], float)
     path = refit_ring(square, tolerance=0.5)
-    assert np.allclose(path, straight_path(square))
+    assert len(path) == 12
+    assert {tuple(p) for p in np.round(path[0::3], 6)} == {tuple(p) for p in square}
+    assert np.allclose(shapely.Polygon(flatten_path(path)).area, 100 * 100)
 
 
-def test_a_fit_that_would_cross_falls_back_to_a_simple_polygon():
+def test_a_fit_that_would_cross_falls_back_to_a_simple_polygon(fitter):
     # A thin zig-zag comb: cubics fitted at a large tolerance would cut across its teeth.
     teeth = [
         [x, y] for i, x in enumerate(range(0, 200, 10)) for y in ((0, 40) if i % 2 else (40, 0))
@@ -68,6 +83,17 @@ def test_a_fit_that_would_cross_falls_back_to_a_simple_polygon():
     assert shapely.LinearRing(comb).is_simple
     path = refit_ring(comb, tolerance=8.0)
     assert is_simple(path)
+
+
+def test_a_fresh_fit_stays_inside_the_box(fitter):
+    angles = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    ring = np.stack([50 + 50 * np.cos(angles), 50 + 50 * np.sin(angles)], 1)
+    box = (-1.0, -1.0, 101.0, 101.0)
+    path = refit_ring(ring, tolerance=0.5, box=box)
+    assert np.all(path >= -1.0) and np.all(path <= 101.0)
+    assert is_simple(path)
+    drawn = shapely.Polygon(flatten_path(path))
+    assert drawn.hausdorff_distance(shapely.Polygon(ring)) < 0.5 + FLATTEN_TOLERANCE
 
 
 def test_figure_eight_lobes_redraw_on_their_own_curves():

@@ -3,6 +3,7 @@
 import numpy as np
 
 from samvg.finish import crossing_paths, finish_scene, simplify_paths
+from samvg.finish.cubics import cubics_of, path_of, straight_path
 from samvg.finish.flatten import flatten_path
 from samvg.finish.outline import fill_region
 from tests.finish.shapes import (
@@ -38,6 +39,7 @@ def test_a_crossing_inside_a_segment_splits_the_bow_tie_into_two_triangles():
         "simple_repaired": 1,
         "simple_split": 1,
         "simple_dropped": 0,
+        "simple_holes_filled": 0,
     }
     assert repaired.path_count == 3
     assert np.array_equal(repaired.path_points(0), scene.path_points(0))
@@ -73,3 +75,20 @@ def test_a_collapsed_path_is_dropped():
     assert counts["simple_dropped"] == 1
     assert repaired.path_count == 1
     assert repaired.paints[0].rgba == BLUE
+
+
+def test_a_hole_a_path_loops_round_is_filled_and_counted():
+    # Round an ellipse one way, across to a smaller one, round it the other way and back: the
+    # two crossings cancel, and the inner ellipse is a hole (winding number 0).
+    outer = cubics_of(ellipse(256, 256, 150, 100))
+    inner = cubics_of(ellipse(256, 256, 60, 40))[::-1, ::-1]
+    across = straight_path(np.array([[406.0, 256.0], [316.0, 256.0]]))
+    there = np.append(across[:3], [[316.0, 256.0]], axis=0)
+    back = np.append(across[3:], [[406.0, 256.0]], axis=0)
+    ring = path_of(np.concatenate([outer, there[None], inner, back[None]]))
+    scene = scene_of((ring, RED))
+    region = fill_region(flatten_path(ring))
+    assert len(region.interiors) == 1
+    repaired, counts = simplify_paths(scene)
+    assert counts["simple_repaired"] == 1 and counts["simple_holes_filled"] == 1
+    assert repaired.path_count == 1 and is_simple(repaired.path_points(0))
