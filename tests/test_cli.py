@@ -99,9 +99,10 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
     stages = sorted(p.name for p in (tmp_path / "stages").iterdir())
     assert {"1_masks.png", "2_initial.svg", "3_optimized.svg", "5_final.svg"} <= set(stages)
     assert "comparison.png" in stages
-    assert VectorImage.load(tmp_path / "stages" / "5_final.svg").to_svg() == VectorImage.load(
-        output
-    ).to_svg()
+    assert (
+        VectorImage.load(tmp_path / "stages" / "5_final.svg").to_svg()
+        == VectorImage.load(output).to_svg()
+    )
     result = VectorImage.load(output)
     target = read_image(SAMPLE).astype(np.float32) / 255.0
     assert (result.width, result.height) == (512, 280)
@@ -155,3 +156,65 @@ def test_batch_skips_done_images_and_survives_failures(tmp_path, capsys):
 def test_batch_needs_an_output_folder(tmp_path, capsys):
     assert main([str(SAMPLE), str(SAMPLE), "-o", str(tmp_path / "x.svg")]) == 1
     assert "-o must be a folder" in capsys.readouterr().err
+
+
+def test_batch_names_inputs_whose_stems_collide_by_their_whole_name(tmp_path, sam_checkpoint):
+    from PIL import Image
+
+    inputs, outputs = tmp_path / "in", tmp_path / "out"
+    inputs.mkdir()
+    Image.new("RGB", (30, 20), (250, 10, 10)).save(inputs / "pic.png")
+    Image.new("RGB", (30, 20), (10, 10, 250)).save(inputs / "pic.jpg", quality=100)
+    Image.new("RGB", (30, 20), (10, 250, 10)).save(inputs / "other.png")
+    options = ["-o", str(outputs), "--quiet", "--no-lpips", "--checkpoint", str(sam_checkpoint)]
+    assert main([str(inputs), *options]) == 0
+    assert sorted(p.name for p in outputs.iterdir()) == ["other.svg", "pic.jpg.svg", "pic.png.svg"]
+    assert VectorImage.load(outputs / "pic.png.svg").background[0] > 0.9  # red, not the blue
+    assert VectorImage.load(outputs / "pic.jpg.svg").background[2] > 0.9
+    # the same file named twice is done once
+    assert (
+        main([str(inputs / "other.png"), str(inputs / "other.png"), *options, "--overwrite"]) == 0
+    )
+
+
+def test_a_one_pixel_image_becomes_a_one_colour_svg(tmp_path, sam_checkpoint):
+    from PIL import Image
+
+    Image.new("RGB", (1, 1), (12, 34, 56)).save(tmp_path / "one.png")
+    code = main([str(tmp_path / "one.png"), "-o", str(tmp_path / "one.svg"), "--quiet"])
+    assert code == 0
+    image = VectorImage.load(tmp_path / "one.svg")
+    assert (image.width, image.height) == (1, 1) and image.paths == []
+    assert np.allclose(image.background, np.array((12, 34, 56)) / 255.0, atol=1e-6)
+
+
+def test_a_full_disk_stops_a_batch_with_one_line(tmp_path, capsys, monkeypatch, sam_checkpoint):
+    import errno
+
+    from PIL import Image
+
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    for name in ("a.png", "b.png"):
+        Image.new("RGB", (30, 20), (250, 10, 10)).save(inputs / name)
+
+    def full(_fd):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr("os.fsync", full)
+    options = ["-o", str(tmp_path / "out"), "--quiet", "--checkpoint", str(sam_checkpoint)]
+    assert main([str(inputs), *options]) == 1
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        f"error: cannot write {tmp_path / 'out' / 'a.svg'}: No space left on device"
+    ]
+    assert list((tmp_path / "out").iterdir()) == []
+
+
+def test_several_line_messages_are_joined_into_one():
+    from samvg.cli import one_line
+
+    message = "could not find x. Tried:\n  cache: not found\n  download: failed\nTo fix: put it"
+    assert one_line(message) == (
+        "could not find x. Tried: cache: not found; download: failed; To fix: put it"
+    )

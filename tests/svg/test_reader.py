@@ -384,9 +384,16 @@ def test_canvas_size(root, size):
         ('width="10mm" height="10"', "only plain pixel lengths"),
         ('viewBox="0 0 10"', "is not four numbers"),
         ('viewBox="0 0 0 10"', "has no area"),
+        ('width="0" height="10"', "needs a positive width"),  # was a ZeroDivisionError
+        ('width="-64" height="64"', "needs a positive width"),  # was a 1x64 canvas
+        ('viewBox="0 0 10 10" height="0"', "needs a positive height"),
+        ('xmlns:x="y" width="5" height="5" x:a="1"', ""),
     ],
 )
 def test_bad_canvas_is_a_clear_error(root, message):
+    if not message:  # a foreign attribute on the root is harmless
+        read_svg(f'<svg xmlns="http://www.w3.org/2000/svg" {root}><path {TRIANGLE}/></svg>')
+        return
     with pytest.raises(InputError, match=re.escape(message)):
         read_svg(f'<svg xmlns="http://www.w3.org/2000/svg" {root}><path {TRIANGLE}/></svg>')
 
@@ -572,3 +579,25 @@ def test_render_matches_resvg_for_transforms_arcs_and_quadratics():
     theirs = resvg_render(RESVG_SCENE, 96, 64)
     assert ours.shape == theirs.shape == (64, 96, 3)
     assert np.abs(ours - theirs).mean() <= 2 / 255
+
+
+def test_nesting_is_refused_beyond_500_levels_without_recursion():
+    def nested(depth: int) -> str:
+        return svg("<g>" * depth + f"<path {TRIANGLE}/>" + "</g>" * depth)
+
+    assert len(read_svg(nested(498)).paths) == 1  # 498 groups: the path is at level 500
+    for depth in (499, 100_000):  # 10^5 levels was a RecursionError
+        with pytest.raises(InputError, match="nested over 500 levels"):
+            read_svg(nested(depth))
+
+
+def test_root_outside_the_svg_namespace_and_a_hidden_root():
+    with pytest.raises(InputError, match="not in the SVG namespace"):
+        read_svg(f'<svg xmlns="x" width="5" height="5"><path {TRIANGLE}/></svg>')
+    hidden = read_svg(svg(f"<path {TRIANGLE}/>", extra='style="display:none"'))
+    assert (hidden.width, hidden.height, hidden.paths) == (10, 10, [])
+
+
+def test_font_relative_lengths_are_refused():
+    with pytest.raises(InputError, match="em and ex lengths are not supported"):
+        read_svg(svg('<circle cx="2em" cy="1" r="1"/>'))
