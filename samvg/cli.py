@@ -144,14 +144,21 @@ def _config(arguments: argparse.Namespace) -> Config:
         "threads": arguments.threads,
         "lpips_weights": arguments.lpips_weights,
         "missing_rounds": arguments.missing_rounds,
+        "tolerance": arguments.tolerance,
+        "colors": arguments.colors,
     }
     settings.update({key: value for key, value in optional.items() if value is not None})
     if arguments.no_lpips:
         settings["use_lpips"] = False
     if arguments.no_filter:
         settings["filter_by_impact"] = False
+    if arguments.translucent:
+        settings["translucent"] = True
+    if arguments.no_finish:
+        settings["finish_pass"] = False
     preset = "fast" if arguments.fast else arguments.preset
-    return Config.fast(**settings) if preset == "fast" else Config.paper(**settings)
+    constructors = {"default": Config, "paper": Config.paper, "fast": Config.fast}
+    return constructors[preset](**settings)
 
 
 def _expand_inputs(inputs: list[str]) -> tuple[list[Path], bool]:
@@ -386,6 +393,66 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
+    """The ``vectorize`` options that tune the method (paths, segments, fitting, SAM)."""
+    vectorize.add_argument("--max-paths", type=int, help="at most this many paths")
+    vectorize.add_argument(
+        "--segments",
+        type=int,
+        help="cubic segments per path (default: as few as fit within --tolerance; paper: 5)",
+    )
+    vectorize.add_argument(
+        "--tolerance",
+        type=float,
+        help="largest distance in working pixels between an outline and its path when the "
+        "segments are chosen per path (default 2; like potrace's opttolerance)",
+    )
+    vectorize.add_argument(
+        "--colors", type=int, help="snap the fills to this many colours (k-means in CIELAB)"
+    )
+    vectorize.add_argument(
+        "--translucent",
+        action="store_true",
+        help="learn each fill's opacity (default: opaque fills, unless the input has alpha)",
+    )
+    vectorize.add_argument(
+        "--no-finish",
+        action="store_true",
+        help="skip the finish pass (untangling, bounds, hidden paths, merges)",
+    )
+    vectorize.add_argument(
+        "--iterations", type=int, help="optimization steps per phase (default 500, two phases)"
+    )
+    vectorize.add_argument(
+        "--size",
+        type=int,
+        help="working resolution, longest side (default 512); the SVG keeps "
+        "the input's pixel coordinates",
+    )
+    vectorize.add_argument("--seed", type=int, default=0, help="random seed, 0 to 2**32 - 1")
+    vectorize.add_argument("--device", default="cpu", help="cpu (default), cuda, cuda:N or mps")
+    vectorize.add_argument(
+        "--threads", type=int, help="torch threads for SAM (default: torch's; 1 on a busy machine)"
+    )
+    vectorize.add_argument(
+        "--model",
+        default="mobile_sam",
+        help="SAM variant: mobile_sam (default), vit_b, vit_l, vit_h",
+    )
+    vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
+    vectorize.add_argument("--crops", type=int, help="SAM crop layers (test-time augmentation)")
+    vectorize.add_argument(
+        "--missing-rounds", type=int, help="rounds of stage 4, adding missing parts (default 1)"
+    )
+    vectorize.add_argument("--no-lpips", action="store_true", help="optimize MSE + Xing only")
+    vectorize.add_argument("--lpips-weights", help="LPIPS weight file (flat state dict)")
+    vectorize.add_argument(
+        "--no-filter",
+        action="store_true",
+        help="keep every SAM mask (the paper's ablation of filter by impact)",
+    )
+
+
 def _add_vectorize_command(commands: Any) -> None:
     """The ``vectorize`` sub-command and its options."""
     vectorize = commands.add_parser(
@@ -405,44 +472,14 @@ def _add_vectorize_command(commands: Any) -> None:
     )
     vectorize.add_argument(
         "--preset",
-        choices=("paper", "fast"),
-        default="paper",
-        help="paper: the paper's procedure (default); fast: 16x16 grid, 384 px, "
-        "120 steps a phase, no LPIPS",
+        choices=("default", "paper", "fast"),
+        default="default",
+        help="default: segments per outline, opaque fills, finish pass; paper: the paper's "
+        "exact procedure (5 segments, learned opacity, no finish pass); fast: the default with "
+        "a 16x16 grid, 384 px, 120 steps a phase, no LPIPS",
     )
     vectorize.add_argument("--fast", action="store_true", help="same as --preset fast")
-    vectorize.add_argument("--max-paths", type=int, help="at most this many paths")
-    vectorize.add_argument("--segments", type=int, help="cubic segments per path (default 5)")
-    vectorize.add_argument(
-        "--iterations", type=int, help="optimization steps per phase (default 500, two phases)"
-    )
-    vectorize.add_argument(
-        "--size",
-        type=int,
-        help="working resolution, longest side (default 512); the SVG keeps "
-        "the input's pixel coordinates",
-    )
-    vectorize.add_argument("--seed", type=int, default=0, help="random seed, 0 to 2**32 - 1")
-    vectorize.add_argument("--device", default="cpu", help="cpu (default), cuda, cuda:N or mps")
-    vectorize.add_argument("--threads", type=int,
-                           help="torch threads for SAM (default: torch's; 1 on a busy machine)")
-    vectorize.add_argument(
-        "--model",
-        default="mobile_sam",
-        help="SAM variant: mobile_sam (default), vit_b, vit_l, vit_h",
-    )
-    vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
-    vectorize.add_argument("--crops", type=int, help="SAM crop layers (test-time augmentation)")
-    vectorize.add_argument(
-        "--missing-rounds", type=int, help="rounds of stage 4, adding missing parts (default 1)"
-    )
-    vectorize.add_argument("--no-lpips", action="store_true", help="optimize MSE + Xing only")
-    vectorize.add_argument("--lpips-weights", help="LPIPS weight file (flat state dict)")
-    vectorize.add_argument(
-        "--no-filter",
-        action="store_true",
-        help="keep every SAM mask (the paper's ablation of filter by impact)",
-    )
+    _add_tuning_options(vectorize)
     vectorize.add_argument(
         "--precision", type=int, default=2, help="decimals in SVG output, 0 to 10 (default 2)"
     )

@@ -100,11 +100,27 @@ class SegmentOptions:
 class TraceOptions:
     """Stage 2: mask components to closed cubic paths."""
 
-    segments: int = 5
-    """Cubic segments per path."""
+    segments: int | None = None
+    """Cubic segments per path (the paper: 5); None: as few as fit within ``tolerance``."""
+    tolerance: float = 2.0
+    """Largest distance (working pixels) between a mask's outline and its traced path, when the
+    segment count is chosen per path (like potrace's opttolerance)."""
+    max_segments: int = 32
+    reshape: bool = True
+    """Between fitting phases, untangle each path and choose its segments again within the
+    tolerance (split where the outline grew detail, merge where it became simple)."""
 
     def __post_init__(self) -> None:
-        _check_integer(self, "segments", 1)
+        if self.segments is not None:
+            _check_integer(self, "segments", 1)
+        _check_integer(self, "max_segments", 1)
+        _check_non_negative(self, "tolerance")
+        if self.tolerance <= 0:
+            raise InputError(f"tolerance must be a positive number, got {self.tolerance!r}")
+
+    @property
+    def adaptive(self) -> bool:
+        return self.segments is None
 
 
 @dataclass(frozen=True)
@@ -121,9 +137,10 @@ class FitOptions:
     lpips_size: int = 128
     """LPIPS is computed on the render resized to this longest side (cost, not quality)."""
     lpips_weights: str | None = None
-    translucent: bool = True
-    """Learn each fill's opacity; off keeps every fill opaque (alpha 1)."""
-    margin: float | None = None
+    translucent: bool = False
+    """Learn each fill's opacity (the paper does); off keeps every fill opaque, except on
+    inputs with an alpha channel."""
+    margin: float | None = 0.02
     """Keep control points within the canvas plus this fraction of its longer side (None: no
     bound, the paper's setting)."""
 
@@ -138,6 +155,23 @@ class FitOptions:
     @property
     def wants_lpips(self) -> bool:
         return self.use_lpips and self.lpips_weight > 0 and self.iterations > 0
+
+
+@dataclass(frozen=True)
+class FinishOptions:
+    """The finish pass: simple, bounded paths, hidden paths removed, touching paths of near-equal
+    colour merged, optionally a palette (see `samvg.finish`)."""
+
+    finish_pass: bool = True
+    """Run the finish pass (the paper has none)."""
+    colors: int | None = None
+    """Snap the fills to this many colours (k-means in CIELAB), like Illustrator's colours."""
+    remove_hidden: bool = True
+    merge_paths: bool = True
+
+    def __post_init__(self) -> None:
+        if self.colors is not None:
+            _check_integer(self, "colors", 1)
 
 
 @dataclass(frozen=True)
@@ -170,8 +204,9 @@ _GROUPS = {
     "trace": TraceOptions,
     "fit": FitOptions,
     "missing": MissingOptions,
+    "finish": FinishOptions,
 }
-_GROUP_OF = {
+_GROUP_OF: dict[str, str] = {
     option.name: group for group, kind in _GROUPS.items() for option in dataclasses.fields(kind)
 }
 
@@ -180,15 +215,18 @@ _GROUP_OF = {
 class Config:
     """Settings of :func:`samvg.vectorize`, one group per stage plus the run's own.
 
-    ``Config()`` and ``Config.paper()`` are the paper's procedure, ``Config.fast()`` the quick
-    preset. Any setting of a group can also be given by name: ``Config(iterations=300)`` is
-    ``Config(fit=FitOptions(iterations=300))``; the same holds for the presets and `replace`.
+    ``Config()`` is the product default (segments chosen per outline, opaque fills, bounded
+    points, a finish pass), ``Config.paper()`` the paper's exact procedure and ``Config.fast()``
+    the quick version of the default. Any setting of a group can also be given by name:
+    ``Config(iterations=300)`` is ``Config(fit=FitOptions(iterations=300))``; the same holds for
+    the presets and `replace`.
     """
 
     segment: SegmentOptions
     trace: TraceOptions
     fit: FitOptions
     missing: MissingOptions
+    finish: FinishOptions
     size: int = 512
     """Working resolution (longest side); the SVG keeps the input's pixel coordinates."""
     seed: int = 0
@@ -203,6 +241,7 @@ class Config:
         trace: TraceOptions | None = None,
         fit: FitOptions | None = None,
         missing: MissingOptions | None = None,
+        finish: FinishOptions | None = None,
         *,
         size: int = 512,
         seed: int = 0,
@@ -215,6 +254,7 @@ class Config:
             "trace": trace or TraceOptions(),
             "fit": fit or FitOptions(),
             "missing": missing or MissingOptions(),
+            "finish": finish or FinishOptions(),
         }
         for name, value in settings.items():
             group = _GROUP_OF.get(name)
@@ -246,21 +286,15 @@ class Config:
 
     @classmethod
     def paper(cls, **overrides: Any) -> Config:
-        """The paper's procedure: 32x32 grid, 5 segments, 500 + 500 steps, LPIPS, one stage-4
-        round (the default)."""
-        return cls(**overrides)
+        """The paper's procedure: 32x32 grid, 5 segments a path, learned opacity, no bounds,
+        500 + 500 steps with LPIPS, one stage-4 round, no finish pass."""
+        return cls(**{**PAPER, **overrides})
 
     @classmethod
     def fast(cls, **overrides: Any) -> Config:
-        """The quick preset: a 16x16 grid, 384-px working size, 120 steps a phase, MSE only."""
-        settings: dict[str, Any] = {
-            "points_per_side": 16,
-            "size": 384,
-            "iterations": 120,
-            "use_lpips": False,
-        }
-        settings.update(overrides)
-        return cls(**settings)
+        """The quick preset: the default with a 16x16 grid, 384-px working size, 120 steps a
+        phase and MSE only."""
+        return cls(**{**FAST, **overrides})
 
     def replace(self, **changes: Any) -> Config:
         """A copy with some settings changed, by group or by name (checked again)."""
@@ -281,3 +315,14 @@ class Config:
 
 
 _RUN = ("size", "seed", "device", "threads")
+
+#: How `Config.paper` differs from the default.
+PAPER: dict[str, Any] = {
+    "segments": 5,
+    "reshape": False,
+    "translucent": True,
+    "margin": None,
+    "finish_pass": False,
+}
+#: How `Config.fast` differs from the default.
+FAST: dict[str, Any] = {"points_per_side": 16, "size": 384, "iterations": 120, "use_lpips": False}

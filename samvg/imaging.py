@@ -85,6 +85,27 @@ def _to_unit_float(arr: np.ndarray) -> np.ndarray:
     raise InputError(f"unsupported image dtype {arr.dtype}")
 
 
+def alpha_channel(image: np.ndarray | Image.Image) -> np.ndarray | None:
+    """The opacity of an image with an alpha channel as float32 (H, W) in [0, 1], or None when
+    it has none or every pixel is opaque (the image is then treated as opaque)."""
+    if isinstance(image, Image.Image):
+        if image.mode not in ("RGBA", "LA", "PA") and not (
+            image.mode == "P" and "transparency" in image.info
+        ):
+            return None
+        alpha = np.asarray(image.convert("RGBA"))[:, :, 3].astype(np.float32) / 255.0
+    else:
+        array = np.asarray(image)
+        if array.ndim != 3 or array.shape[2] not in (2, 4):
+            return None
+        alpha = (
+            _to_unit_float(array[:, :, -1])
+            if array.dtype != np.uint8
+            else (array[:, :, -1].astype(np.float32) / 255.0)
+        )
+    return alpha if alpha.size and float(alpha.min()) < 1.0 else None
+
+
 def to_float_rgb(image: np.ndarray | Image.Image, name: str = "image") -> np.ndarray:
     """``image`` as a float32 (H, W, 3) array in [0, 1]: the one uint8-to-float rule of samvg.
 

@@ -12,7 +12,7 @@ import numpy as np
 from PIL import Image, ImageOps
 
 from samvg.errors import InputError, OutputError
-from samvg.imaging import to_rgb_uint8
+from samvg.imaging import alpha_channel, to_rgb_uint8
 
 
 def replace_with_default_permissions(temporary: str | os.PathLike[str], target: Path) -> None:
@@ -64,6 +64,12 @@ def read_image(path: str | os.PathLike[str]) -> np.ndarray:
 
     Raises :class:`InputError` for a missing, unreadable, corrupt or empty file.
     """
+    return read_image_with_alpha(path)[0]
+
+
+def read_image_with_alpha(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`read_image`, and the image's opacity as float32 (H, W) in [0, 1] when it has an
+    alpha channel with any pixel not fully opaque (else None)."""
     from PIL import UnidentifiedImageError
 
     source = Path(path)
@@ -75,7 +81,8 @@ def read_image(path: str | os.PathLike[str]) -> np.ndarray:
         with Image.open(source) as opened:
             opened.load()
             upright = ImageOps.exif_transpose(opened)
-            return to_rgb_uint8(upright if upright is not None else opened)
+            picture = upright if upright is not None else opened
+            return to_rgb_uint8(picture), alpha_channel(picture)
     except (
         UnidentifiedImageError,
         Image.DecompressionBombError,

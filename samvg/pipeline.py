@@ -20,15 +20,23 @@ import torch
 from samvg.config import Config, FitOptions, SegmentOptions
 from samvg.device import check_device
 from samvg.errors import WeightsNotFoundError
-from samvg.imaging import resize_longest, to_float_rgb, to_rgb_uint8
-from samvg.io import read_image
+from samvg.finish import FinishSettings, finish_scene, flatten_paths
+from samvg.finish.outline import polygon_areas
+from samvg.imaging import alpha_channel, resize_longest, to_float_rgb, to_rgb_uint8
+from samvg.io import read_image_with_alpha
 from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
 from samvg.missing import MissingSettings, add_missing
 from samvg.optimize import FitSettings, fit_scene
+from samvg.optimize.reshape import reshape_scene
 from samvg.sam import SPECS
 from samvg.scene import Frame, Scene
 from samvg.segment import Segmenter, SegmentSettings, select_masks
-from samvg.trace.stage import TraceSettings, trace_scene, uncovered_background
+from samvg.trace.stage import (
+    TraceSettings,
+    drop_transparent,
+    trace_scene,
+    uncovered_background,
+)
 from samvg.vector_image import VectorImage
 from samvg.weights import cache_dir, ensure_cache_folder, resolve_weights
 
@@ -63,11 +71,20 @@ class PipelineResult:
     notes: list[str] = field(default_factory=list)
 
 
-def load_input(image: Any) -> np.ndarray:
-    """A path or an in-memory image (numpy array or PIL image) as (H, W, 3) uint8 RGB."""
+def load_input(image: Any) -> tuple[np.ndarray, np.ndarray | None]:
+    """A path or an in-memory image (numpy array or PIL image) as (H, W, 3) uint8 RGB, and its
+    opacity (H, W) in [0, 1] when it has an alpha channel that is not opaque everywhere."""
     if isinstance(image, (str, os.PathLike)):
-        return read_image(image)
-    return to_rgb_uint8(image)
+        return read_image_with_alpha(image)
+    return to_rgb_uint8(image), alpha_channel(image)
+
+
+def _working_alpha(alpha: np.ndarray | None, shape: tuple[int, ...]) -> np.ndarray | None:
+    """The opacity resized to the working image (Lanczos, as the image)."""
+    if alpha is None or alpha.shape == shape[:2]:
+        return alpha
+    grey = np.repeat(np.round(alpha * 255.0).astype(np.uint8)[:, :, None], 3, axis=2)
+    return to_float_rgb(resize_longest(grey, max(shape[:2]))[0])[:, :, 0]
 
 
 @contextlib.contextmanager
@@ -107,14 +124,15 @@ def run(
     started = time.perf_counter()
     check_device(config.device)
     with _torch_threads(config.threads):
-        original = load_input(image)
+        original, alpha = load_input(image)
         working, scale = resize_longest(original, config.size)
         target = to_float_rgb(working)
         frame = Frame(original.shape[1], original.shape[0], scale)
         result = PipelineResult(image=VectorImage(frame.width, frame.height), scale=scale)
         result.target = target
         if not _is_flat(target, frame, result):
-            _run_stages(working, target, frame, config, result, report, say)
+            inputs = _Inputs(working, target, _working_alpha(alpha, working.shape), frame)
+            _run_stages(inputs, config, result, report, say)
     result.timings["total"] = time.perf_counter() - started
     return result
 
@@ -160,69 +178,147 @@ def _check_lpips_weights(options: FitOptions) -> None:
     read_lpips_state(path)
 
 
-def fit_settings(options: FitOptions, target: np.ndarray) -> tuple[FitSettings, str | None]:
+def fit_settings(
+    options: FitOptions, target: np.ndarray, canvas: tuple[int, int] | None = None
+) -> tuple[FitSettings, str | None]:
     """Stage 3's settings bound to ``target``, and a note when LPIPS was left out because its
     weights are nowhere to be found (nothing named, nothing cached, no download worked). LPIPS
     weights that were named or cached but cannot be loaded raise `WeightsError`."""
     try:
-        return FitSettings.from_options(options, target), None
+        return FitSettings.from_options(options, target, canvas), None
     except (WeightsNotFoundError, ImportError) as error:
         note = f"LPIPS off (MSE + Xing only): {str(error).splitlines()[0]}"
-        return FitSettings.from_options(options), note
+        return FitSettings.from_options(options, canvas=canvas), note
 
 
 def _progress_of(report: ProgressCallback, stage: str, steps: int) -> Callable[[int, float], None]:
     return lambda step, _loss: report(stage, step + 1, steps)
 
 
+@dataclass(frozen=True)
+class _Inputs:
+    """The working image (uint8 and float), its opacity (None: opaque), the input frame."""
+
+    working: np.ndarray
+    target: np.ndarray
+    alpha: np.ndarray | None
+    frame: Frame
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self.target.shape[1], self.target.shape[0]
+
+
 def _run_stages(
-    working: np.ndarray,
-    target: np.ndarray,
-    frame: Frame,
+    inputs: _Inputs,
     config: Config,
     result: PipelineResult,
     report: ProgressCallback,
     say: LogCallback,
 ) -> None:
-    height, width = target.shape[:2]
-    fit, note = fit_settings(config.fit, target)  # before SAM: named LPIPS weights fail first
-    if note is not None:
+    width, height = inputs.size
+    options = config.fit
+    if inputs.alpha is not None:  # translucency is learned where the input has it
+        options = replace(options, translucent=True)
+    fit, note = fit_settings(options, inputs.target, inputs.size)
+    if note is not None:  # before SAM: named LPIPS weights that fail to load fail first
         result.notes.append(note)
         say(note)
     torch.manual_seed(config.seed)
+    segmenter, masks = _segment(inputs, config, result, report)
+    trace_settings = TraceSettings.from_config(config, width, height)
+    with _timed(result, "trace"):
+        report("trace", 0, 1)
+        traced = _within(trace_scene(masks, inputs.target, trace_settings), config)
+        background = (
+            None if inputs.alpha is not None else uncovered_background(masks, inputs.target)
+        )
+        scene = replace(traced, background=background, frame=inputs.frame)
+        report("trace", 1, 1)
+    result.initial = VectorImage.from_scene(scene)
+    result.counts["paths_initial"] = scene.path_count
+    with _timed(result, "optimize"):
+        on_step = _progress_of(report, "optimize", fit.steps)
+        scene = fit_scene(scene, inputs.target, fit, on_step).scene
+    result.optimized = VectorImage.from_scene(scene)
+    missing = MissingSettings.from_config(config, width, height)
+    if missing.rounds and config.trace.adaptive and config.trace.reshape:
+        with _timed(result, "reshape"):
+            scene, counts = reshape_scene(
+                scene, config.trace.tolerance, config.trace.max_segments, _box(config, inputs)
+            )
+        result.counts.update(counts)
+    scene = _add_missing(scene, inputs, segmenter, (missing, trace_settings, fit), result, report)
+    if config.finish.finish_pass:
+        with _timed(result, "finish"):
+            report("finish", 0, 1)
+            finished = finish_scene(scene, _finish_settings(config, inputs))
+            scene = _within(finished.scene, config, by_area=True)
+            result.counts.update(finished.counts)
+            report("finish", 1, 1)
+    _finish(scene, inputs.target, result)
+
+
+def _segment(
+    inputs: _Inputs, config: Config, result: PipelineResult, report: ProgressCallback
+) -> tuple[Segmenter, list[np.ndarray]]:
+    """Stage 1: the segmenter (kept for stage 4) and the masks to trace, in paint order."""
+    width, height = inputs.size
     with _timed(result, "segment"):
         report("segment", 0, 1)
         segmenter = Segmenter(config.segment, config.device)
         settings = SegmentSettings.from_config(config, width, height)
-        selection = select_masks(working, segmenter, settings)
+        selection = select_masks(inputs.working, segmenter, settings)
         report("segment", 1, 1)
-    result.masks = selection.masks
+    result.masks = drop_transparent(selection.masks, inputs.alpha)
     result.counts.update(
         amg_masks=selection.amg_masks,
         amg_components=selection.amg_components,
         kept_masks=selection.kept_after_filter,
         reprompt_masks=selection.reprompt_masks,
     )
-    trace_settings = TraceSettings.from_config(config, width, height)
+    return segmenter, result.masks
+
+
+def _trace(
+    masks: list[np.ndarray],
+    inputs: _Inputs,
+    settings: TraceSettings,
+    config: Config,
+    result: PipelineResult,
+    report: ProgressCallback,
+) -> Scene:
+    """Stage 2: the traced scene over the background (none for an input with alpha)."""
     with _timed(result, "trace"):
         report("trace", 0, 1)
-        traced = _within(trace_scene(selection.masks, target, trace_settings), config)
-        background = uncovered_background(selection.masks, target)
-        scene = replace(traced, background=background, frame=frame)
+        traced = _within(trace_scene(masks, inputs.target, settings), config)
+        background = None
+        if inputs.alpha is None:
+            background = uncovered_background(masks, inputs.target)
+        scene = replace(traced, background=background, frame=inputs.frame)
         report("trace", 1, 1)
     result.initial = VectorImage.from_scene(scene)
     result.counts["paths_initial"] = scene.path_count
+    return scene
 
-    with _timed(result, "optimize"):
-        scene = fit_scene(scene, target, fit, _progress_of(report, "optimize", fit.steps)).scene
-    result.optimized = VectorImage.from_scene(scene)
 
-    missing = MissingSettings.from_config(config, width, height)
+def _add_missing(
+    scene: Scene,
+    inputs: _Inputs,
+    segmenter: Segmenter,
+    settings: tuple[MissingSettings, TraceSettings, FitSettings],
+    result: PipelineResult,
+    report: ProgressCallback,
+) -> Scene:
+    """Stage 4, as many rounds as asked."""
+    missing, trace_settings, fit = settings
     result.counts.update(missing_prompts=0, missing_paths=0)
     for _ in range(missing.rounds):
         report("missing", 0, 1)
         on_step = _progress_of(report, "refine", fit.steps)
-        round_ = add_missing(scene, target, segmenter, missing, trace_settings, fit, on_step)
+        round_ = add_missing(
+            scene, inputs.target, segmenter, missing, trace_settings, fit, on_step, inputs.alpha
+        )
         report("missing", 1, 1)
         scene = round_.scene
         result.missing_map, result.missing_prompts = round_.error_map, round_.prompts
@@ -230,14 +326,39 @@ def _run_stages(
         result.counts["missing_paths"] += round_.added
         for stage, seconds in round_.timings.items():
             result.timings[stage] = result.timings.get(stage, 0.0) + seconds
-    _finish(scene, target, result)
+    return scene
 
 
-def _within(scene: Scene, config: Config) -> Scene:
+def _box(config: Config, inputs: _Inputs) -> tuple[float, float, float, float]:
+    """The canvas plus the margin control points stay in (2 % when no margin is set)."""
+    width, height = inputs.size
+    fraction = config.fit.margin if config.fit.margin is not None else 0.02
+    margin = fraction * max(width, height)
+    return (-margin, -margin, width + margin, height + margin)
+
+
+def _finish_settings(config: Config, inputs: _Inputs) -> FinishSettings:
+    box = _box(config, inputs)
+    return FinishSettings(
+        margin=-box[0],
+        remove_hidden=config.finish.remove_hidden,
+        merge=config.finish.merge_paths,
+        colours=config.finish.colors,
+    )
+
+
+def _within(scene: Scene, config: Config, by_area: bool = False) -> Scene:
     """``scene`` with at most ``max_paths`` paths (stage 1 keeps that many masks; a mask that
-    traced into several paths must not break the promise): the first, largest, ones."""
+    traced into several paths, or a path the finish pass split, must not break the promise):
+    the first ones, or with ``by_area`` the largest ones, in paint order."""
     limit = config.segment.max_paths
-    return scene if limit is None or scene.path_count <= limit else scene.subset(range(limit))
+    if limit is None or scene.path_count <= limit:
+        return scene
+    if not by_area:
+        return scene.subset(range(limit))
+    vertices, vertex_offsets = flatten_paths(scene.points, scene.offsets)
+    areas = polygon_areas(vertices, vertex_offsets)
+    return scene.subset(np.sort(np.argsort(-areas, kind="stable")[:limit]))
 
 
 def _finish(scene: Scene, target: np.ndarray, result: PipelineResult) -> None:

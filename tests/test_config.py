@@ -69,3 +69,10 @@ def test_device_and_seed_are_checked_up_front(settings, message):
 
 def test_largest_seed_and_cuda_index_are_accepted():
     assert Config(seed=2**32 - 1, device="cuda:3").seed == 2**32 - 1
+
+
+def test_setting_names_are_unique_and_never_a_group_name():
+    from samvg.config import _GROUP_OF, _GROUPS, _RUN
+
+    assert not set(_GROUP_OF) & (set(_GROUPS) | set(_RUN))
+    assert not Config.paper().finish.finish_pass and Config().finish.finish_pass

@@ -31,10 +31,10 @@ def test_pipeline_stages_on_real_image(emoji, sam_checkpoint):
     stages = []
     result = samvg.run(emoji, config, progress=lambda stage, done, total: stages.append(stage))
     target = emoji.astype(np.float32) / 255.0
-    assert {"segment", "trace", "optimize", "missing"} <= set(stages)
+    assert {"segment", "trace", "optimize", "missing", "finish"} <= set(stages)
     assert result.counts["amg_masks"] >= result.counts["kept_masks"] >= 1
     assert len(result.image.paths) == result.counts["paths"] >= 3
-    assert all(path.num_segments == 5 for path in result.image.paths)
+    assert len({path.num_segments for path in result.image.paths}) > 1  # chosen per outline
     rendered = result.image.render()
     mse = float(np.mean((rendered - target) ** 2))
     assert mse == pytest.approx(result.mse, rel=1e-3)
@@ -181,3 +181,34 @@ def test_bad_images_are_clear_errors(tmp_path):
         samvg.run(tmp_path / "text.png")
     with pytest.raises(InputError, match="NaN"):
         samvg.run(np.full((20, 20, 3), np.nan, np.float32))
+
+
+@pytest.mark.slow
+def test_rgba_input_keeps_its_transparent_background(bench_dir, sam_checkpoint, tmp_path):
+    import io
+
+    import resvg_py
+
+    svg = (bench_dir / "emoji" / "twemoji_grinning_face.svg").read_text()
+    png = bytes(resvg_py.svg_to_bytes(svg_string=svg, width=128, height=128))
+    source = tmp_path / "face.png"
+    Image.open(io.BytesIO(png)).save(source)
+    result = samvg.run(source, Config.fast(checkpoint=str(sam_checkpoint), iterations=30))
+    assert result.image.background is None and "<rect" not in result.image.to_svg()
+    over_black = result.image.scene.with_background((0.0, 0.0, 0.0)).render()
+    assert np.allclose(over_black[1, 1], 0.0) and np.allclose(over_black[-2, -2], 0.0)
+    assert over_black[64, 64].max() > 0.5  # the face itself is drawn
+
+
+@pytest.mark.slow
+def test_default_output_is_opaque_bounded_and_simple(emoji, sam_checkpoint):
+    from samvg.finish import crossing_paths
+
+    result = samvg.run(emoji, Config(checkpoint=str(sam_checkpoint), **QUICK))
+    scene = result.image.scene
+    assert all(paint.rgba[3] == 1.0 for paint in scene.paints)
+    assert len(crossing_paths(scene)) == 0
+    margin = 0.05 * 96
+    assert scene.points.min() >= -margin and scene.points.max() <= 96 + margin
+    paper = samvg.run(emoji, Config.paper(checkpoint=str(sam_checkpoint), **QUICK))
+    assert all(k == 5 for k in paper.image.scene.segment_counts())

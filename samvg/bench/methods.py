@@ -88,7 +88,7 @@ def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:
             baseline_fit_settings(job),
             seed=job.config.seed,
             steps=steps,
-            segments=job.config.trace.segments,
+            segments=job.config.trace.segments or 5,
             progress=lambda done, total: job.progress(name, done, total),
         )
 

@@ -14,7 +14,7 @@ from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import StepCallback
 from samvg.scene import Scene
 from samvg.segment import ImpactCanvas, Segmenter, offer_best
-from samvg.trace.stage import TraceSettings, trace_scene
+from samvg.trace.stage import TraceSettings, drop_transparent, trace_scene
 
 
 @dataclass(frozen=True)
@@ -98,16 +98,18 @@ def add_missing(
     trace: TraceSettings,
     fit: FitSettings,
     on_step: StepCallback | None = None,
+    alpha: np.ndarray | None = None,
 ) -> MissingRound:
     """One round of stage 4 on ``scene`` (working pixels) against ``target``; it adds no more
-    paths than ``settings.max_paths`` leaves room for (none, without asking SAM, when full)."""
+    paths than ``settings.max_paths`` leaves room for (none, without asking SAM, when full),
+    and none where the input is transparent (``alpha`` below 0.5)."""
     clock = time.perf_counter()
     render = scene.render()
     averaged, above = missing_component_map(target, render, settings.radius, settings.threshold)
     prompts = missing_component_prompts(averaged, above)
     room = room_left(scene, settings)
     masks = [] if room == 0 else missing_masks(segmenter, prompts, target, render, settings, room)
-    added = trace_scene(masks, target, trace)
+    added = trace_scene(drop_transparent(masks, alpha), target, trace)
     if room is not None and added.path_count > room:
         added = added.subset(range(room))
     result = MissingRound(scene, averaged, prompts, added.path_count)

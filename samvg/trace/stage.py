@@ -26,7 +26,13 @@ class TraceSettings:
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> TraceSettings:
-        return cls(config.trace.segments, config.segment.min_pixels(width, height))
+        options = config.trace
+        return cls(
+            segments=options.segments if options.segments is not None else 5,
+            min_pixels=config.segment.min_pixels(width, height),
+            tolerance=options.tolerance if options.adaptive else None,
+            max_segments=options.max_segments,
+        )
 
 
 def uncovered_background(masks: list[np.ndarray], target: np.ndarray) -> RGB:
@@ -39,6 +45,16 @@ def uncovered_background(masks: list[np.ndarray], target: np.ndarray) -> RGB:
     else:
         mean = target.reshape(-1, 3).mean(axis=0, dtype=np.float64)
     return (float(mean[0]), float(mean[1]), float(mean[2]))
+
+
+def drop_transparent(masks: list[np.ndarray], alpha: np.ndarray | None) -> list[np.ndarray]:
+    """The masks that lie mostly (at least half their area) where the input is opaque
+    (alpha >= 0.5); all of them for an opaque input (``alpha`` None). A transparent region stays
+    transparent instead of becoming a path of the colour behind it."""
+    if alpha is None:
+        return masks
+    opaque = alpha >= 0.5
+    return [mask for mask in masks if 2 * np.count_nonzero(mask & opaque) >= mask.sum()]
 
 
 def trace_scene(masks: list[np.ndarray], target: np.ndarray, settings: TraceSettings) -> Scene:
