@@ -20,7 +20,13 @@ import torch
 from samvg.config import Config, FitOptions, SegmentOptions
 from samvg.device import check_device
 from samvg.errors import WeightsNotFoundError
-from samvg.finish import FinishSettings, finish_scene, flatten_paths
+from samvg.finish import (
+    FinishSettings,
+    crossing_paths,
+    finish_scene,
+    flatten_paths,
+    simplify_paths,
+)
 from samvg.finish.outline import polygon_areas
 from samvg.imaging import alpha_channel, resize_longest, to_float_rgb, to_rgb_uint8
 from samvg.io import read_image_with_alpha
@@ -45,6 +51,8 @@ ProgressCallback = Callable[[str, int, int], None]
 LogCallback = Callable[[str], None]
 
 UNIFORM_TOLERANCE = 1.5 / 255.0
+#: Decimals of the coordinates `VectorImage.save` writes by default.
+SAVE_PRECISION = 2
 MIN_WORKING_SIDE = 8
 
 
@@ -256,7 +264,7 @@ def _run_stages(
             scene = _within(finished.scene, config, by_area=True)
             result.counts.update(finished.counts)
             report("finish", 1, 1)
-    _finish(scene, inputs.target, result)
+    _finish(scene, inputs.target, result, simple=config.finish.finish_pass)
 
 
 def _segment(
@@ -361,11 +369,23 @@ def _within(scene: Scene, config: Config, by_area: bool = False) -> Scene:
     return scene.subset(np.sort(np.argsort(-areas, kind="stable")[:limit]))
 
 
-def _finish(scene: Scene, target: np.ndarray, result: PipelineResult) -> None:
+def simple_when_saved(scene: Scene, precision: int = SAVE_PRECISION) -> Scene:
+    """``scene`` (input pixels) with coordinates rounded as the SVG will hold them, repairing a
+    path that rounding makes cross itself (two stretches of an outline closer than the
+    rounding step now touch)."""
+    rounded = scene.with_geometry(np.round(scene.points, precision))
+    if len(crossing_paths(rounded)) == 0:
+        return rounded
+    repaired, _ = simplify_paths(rounded)
+    return repaired.with_geometry(np.round(repaired.points, precision))
+
+
+def _finish(scene: Scene, target: np.ndarray, result: PipelineResult, simple: bool = False) -> None:
     result.scene = scene
-    result.image = VectorImage.from_scene(scene)
+    output = scene.in_input_pixels()
+    result.image = VectorImage.from_scene(simple_when_saved(output) if simple else output)
     result.mse = float(np.mean((scene.render() - target) ** 2))
-    result.counts["paths"] = scene.path_count
+    result.counts["paths"] = result.image.scene.path_count
 
 
 def vectorize(
