@@ -263,6 +263,7 @@ def _run_stages(
             finished = finish_scene(scene, _finish_settings(config, inputs))
             scene = _within(finished.scene, config, by_area=True)
             result.counts.update(finished.counts)
+            result.notes.append(_finish_note(finished.counts))
             report("finish", 1, 1)
     _finish(scene, inputs.target, result, simple=config.finish.finish_pass)
 
@@ -367,6 +368,17 @@ def _within(scene: Scene, config: Config, by_area: bool = False) -> Scene:
     vertices, vertex_offsets = flatten_paths(scene.points, scene.offsets)
     areas = polygon_areas(vertices, vertex_offsets)
     return scene.subset(np.sort(np.argsort(-areas, kind="stable")[:limit]))
+
+
+def _finish_note(counts: dict[str, int]) -> str:
+    """What the finish pass changed, in one line."""
+    return (
+        f"finish: {counts.get('simple_repaired', 0)} self-crossing paths repaired "
+        f"({counts.get('simple_split', 0)} parts split off), "
+        f"{counts.get('bounds_clipped', 0)} clipped to the canvas, "
+        f"{counts.get('hidden_removed', 0)} hidden paths removed, "
+        f"{counts.get('merged', 0)} merged"
+    )
 
 
 def simple_when_saved(scene: Scene, precision: int = SAVE_PRECISION) -> Scene:
