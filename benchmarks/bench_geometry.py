@@ -2,9 +2,9 @@
 canvas, translucent fills, parameters per path, SVG bytes, MSE and LPIPS; the default settings
 against fixed 5 segments per path at the same path count.
 
-    python benchmarks/bench_geometry.py --out runs/geometry            # all 75 images, resumes
-    python benchmarks/bench_geometry.py --out runs/geometry --per-category 4
-    python benchmarks/bench_geometry.py --out runs/geometry --report-only
+    python benchmarks/bench_geometry.py --settings default             # all 75 images, resumes
+    python benchmarks/bench_geometry.py --per-category 4 --settings default,fixed5
+    python benchmarks/bench_geometry.py --report-only
 
 Each image's result is a JSON file in ``--out`` (a rerun skips what is there), and the report
 goes to ``benchmarks/results/geometry.md``. The checks are independent of the finish pass: every
@@ -197,7 +197,7 @@ def write_report(out: Path, names: list[str], report: Path) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--out", type=Path, default=REPO / "benchmarks/results/geometry")
     parser.add_argument("--per-category", type=int)
     parser.add_argument("--settings", default="default,fixed5")
     parser.add_argument("--report", type=Path, default=REPO / "benchmarks/results/geometry.md")
