@@ -14,26 +14,21 @@ output path is flattened and tested with shapely in the SVG's own (input) pixels
 from __future__ import annotations
 
 import argparse
-import csv
 import json
-import os
-import time
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import shapely
+from bench_images import REPO, bench_entries, run_samvg
 
 import samvg
 from samvg.finish import flatten_paths
-from samvg.imaging import resize_longest, to_float_rgb
-from samvg.io import atomic_write_text, read_image
+from samvg.io import atomic_write_text
 from samvg.metrics import load_lpips, lpips_distance
 from samvg.scene import Scene
 
-REPO = Path(__file__).resolve().parents[1]
-BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
 OUTSIDE_FRACTION = 0.05
 
 
@@ -67,22 +62,17 @@ def geometry_checks(scene: Scene, opaque_input: bool) -> dict[str, Any]:
 
 
 def run_one(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dict[str, Any]:
-    original = read_image(BENCH / entry["png"])
-    working, scale = resize_longest(original, config.size)
-    target = to_float_rgb(working)
-    started = time.perf_counter()
-    result = samvg.run(original, config)
-    seconds = time.perf_counter() - started
-    render = np.clip(result.image.render(scale=scale)[: target.shape[0], : target.shape[1]], 0, 1)
-    written = samvg.VectorImage.from_svg(result.image.to_svg())  # what the SVG file holds
+    run = run_samvg(entry, config)
+    render = run.render()
+    written = samvg.VectorImage.from_svg(run.result.image.to_svg())  # what the SVG file holds
     record = geometry_checks(written.scene, opaque_input=True)
     record.update(
         id=entry["id"],
         category=entry["category"],
-        svg_bytes=len(result.image.to_svg().encode()),
-        mse=float(np.mean((render - target) ** 2)),
-        lpips=lpips_distance(lpips, render, target),
-        seconds=seconds,
+        svg_bytes=len(run.result.image.to_svg().encode()),
+        mse=float(np.mean((render - run.target) ** 2)),
+        lpips=lpips_distance(lpips, render, run.target),
+        seconds=run.seconds,
     )
     return record
 
@@ -93,18 +83,6 @@ def configs(name: str, paths: int | None) -> samvg.Config:
     if name == "fixed5":
         return samvg.Config(segments=5, max_paths=paths)
     raise SystemExit(f"unknown setting {name!r}")
-
-
-def chosen_entries(per_category: int | None) -> list[dict[str, str]]:
-    with open(BENCH / "manifest.csv", newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    if per_category is None:
-        return rows
-    picked: dict[str, list[dict[str, str]]] = defaultdict(list)
-    for row in rows:
-        if len(picked[row["category"]]) < per_category:
-            picked[row["category"]].append(row)
-    return [row for category in sorted(picked) for row in picked[category]]
 
 
 def run_all(entries: list[dict[str, str]], out: Path, names: list[str]) -> None:
@@ -205,7 +183,7 @@ def main() -> None:
     arguments = parser.parse_args()
     names = arguments.settings.split(",")
     if not arguments.report_only:
-        run_all(chosen_entries(arguments.per_category), arguments.out, names)
+        run_all(bench_entries(arguments.per_category), arguments.out, names)
     write_report(arguments.out, names, arguments.report)
 
 

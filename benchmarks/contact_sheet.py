@@ -10,27 +10,20 @@ sheets must not be committed (the bench's licences forbid copies of them in the 
 from __future__ import annotations
 
 import argparse
-import csv
 import io
-import os
 import sys
-import time
-from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
+from bench_images import REPO, bench_entries, run_samvg
 from PIL import Image, ImageDraw
 
 import samvg
 from samvg.baselines import render_svg
-from samvg.imaging import resize_longest, to_float_rgb
-from samvg.io import read_image
 
-REPO = Path(__file__).resolve().parents[1]
-BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
 CELL = 256
 CAPTION = 30
-PRESETS = {"paper": samvg.Config.paper, "fast": samvg.Config.fast}
+PRESETS = {"default": samvg.Config, "paper": samvg.Config.paper, "fast": samvg.Config.fast}
 
 
 def vtracer_default(image: np.ndarray) -> str:
@@ -53,14 +46,10 @@ def cell(picture: np.ndarray, caption: str) -> Image.Image:
 
 
 def row_for(entry: dict[str, str], config: samvg.Config) -> list[Image.Image]:
-    original = read_image(BENCH / entry["png"])
-    working, scale = resize_longest(original, config.size)
-    target = to_float_rgb(working)
-    started = time.perf_counter()
-    result = samvg.run(original, config)
-    seconds = time.perf_counter() - started
-    ours = result.image.render(scale=scale)[: target.shape[0], : target.shape[1]]
-    svg = vtracer_default(working)
+    run = run_samvg(entry, config)
+    target, result = run.target, run.result
+    ours = run.render()
+    svg = vtracer_default(run.working)
     theirs = render_svg(svg, target.shape[1], target.shape[0])
     paths_theirs = svg.count("<path")
 
@@ -68,19 +57,16 @@ def row_for(entry: dict[str, str], config: samvg.Config) -> list[Image.Image]:
         return float(np.mean((picture - target) ** 2))
 
     ours_bytes = len(result.image.to_svg().encode())
+    paths = result.counts.get("paths", 0)
     print(
-        f"{entry['id']}: samvg {result.counts.get('paths', 0)} paths, mse {mse(ours):.4f}, "
-        f"{ours_bytes} B, {seconds:.1f} s | vtracer {paths_theirs} paths, "
-        f"mse {mse(theirs):.4f}, {len(svg)} B",
+        f"{entry['id']}: samvg {paths} paths, mse {mse(ours):.4f}, {ours_bytes} B, "
+        f"{run.seconds:.1f} s | vtracer {paths_theirs} paths, mse {mse(theirs):.4f}, "
+        f"{len(svg)} B",
         flush=True,
     )
     return [
         cell(target, f"{entry['id'][:36]}"),
-        cell(
-            ours,
-            f"samvg {result.counts.get('paths', 0)}p {mse(ours) * 1e3:.1f}e-3 "
-            f"{ours_bytes / 1e3:.1f}kB",
-        ),
+        cell(ours, f"samvg {paths}p {mse(ours) * 1e3:.1f}e-3 {ours_bytes / 1e3:.1f}kB"),
         cell(theirs, f"vtracer {paths_theirs}p {mse(theirs) * 1e3:.1f}e-3 {len(svg) / 1e3:.0f}kB"),
     ]
 
@@ -95,16 +81,8 @@ def main() -> None:
     wanted = arguments.categories.split(",")
     if arguments.output.resolve().is_relative_to(REPO) and {"photo", "painting"} & set(wanted):
         sys.exit("photo and painting sheets stay out of the repository: write them elsewhere")
-    with open(BENCH / "manifest.csv", newline="") as handle:
-        chosen: dict[str, list[dict[str, str]]] = defaultdict(list)
-        for entry in csv.DictReader(handle):
-            if (
-                entry["category"] in wanted
-                and len(chosen[entry["category"]]) < arguments.per_category
-            ):
-                chosen[entry["category"]].append(entry)
     config = PRESETS[arguments.preset]()
-    rows = [row_for(entry, config) for category in wanted for entry in chosen[category]]
+    rows = [row_for(entry, config) for entry in bench_entries(arguments.per_category, wanted)]
     sheet = Image.new("RGB", (3 * CELL, len(rows) * (CELL + CAPTION)), "white")
     for index, row in enumerate(rows):
         for column, picture in enumerate(row):

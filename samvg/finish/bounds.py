@@ -13,7 +13,7 @@ import shapely
 from shapely.geometry.base import BaseGeometry
 
 from samvg.finish.cubics import Box
-from samvg.finish.edits import Edit, apply_edits
+from samvg.finish.edits import Edit, apply_edits, edit_counts
 from samvg.finish.flatten import flatten_paths
 from samvg.finish.outline import DEGENERATE_AREA, fill_region, filled_holes
 from samvg.finish.trim import region_paths
@@ -103,11 +103,4 @@ def bound_paths(
         paths, filled = _clipped(region, source, box, canvas, tolerance, min_part_area)
         edits[int(index)] = [(points, scene.paints[index]) for points in paths]
         holes += filled
-    counts = {
-        "bounds_checked": scene.path_count,
-        "bounds_clipped": sum(1 for edit in edits.values() if edit),
-        "bounds_split": sum(max(len(edit) - 1, 0) for edit in edits.values()),
-        "bounds_dropped": sum(1 for edit in edits.values() if not edit),
-        "bounds_holes_filled": holes,
-    }
-    return apply_edits(scene, edits), counts
+    return apply_edits(scene, edits), edit_counts("bounds", scene, edits, holes)

@@ -24,3 +24,17 @@ def apply_edits(scene: Scene, edits: Mapping[int, Edit]) -> Scene:
         else:
             paths.append((points, paint))
     return Scene.from_paths(scene.width, scene.height, paths, scene.background, scene.frame)
+
+
+def edit_counts(step: str, scene: Scene, edits: Mapping[int, Edit], holes: int) -> dict[str, int]:
+    """A step's counts: paths checked, replaced, parts split off, dropped, holes filled; each
+    key starts with ``step``."""
+    return {
+        f"{step}_checked": scene.path_count,
+        f"{step}_{'clipped' if step == 'bounds' else 'repaired'}": sum(
+            1 for edit in edits.values() if edit
+        ),
+        f"{step}_split": sum(max(len(edit) - 1, 0) for edit in edits.values()),
+        f"{step}_dropped": sum(1 for edit in edits.values() if not edit),
+        f"{step}_holes_filled": holes,
+    }

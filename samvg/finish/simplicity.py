@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 
 from samvg.finish.cubics import Box
-from samvg.finish.edits import Edit, apply_edits
+from samvg.finish.edits import Edit, apply_edits, edit_counts
 from samvg.finish.flatten import flatten_paths
 from samvg.finish.outline import fill_region, filled_holes, simple_mask
 from samvg.finish.trim import region_paths
@@ -56,11 +56,4 @@ def simplify_paths(
         holes += filled_holes(region)
         paths = region_paths(region, sources, tolerance, min_part_area, box, canvas)
         edits[int(index)] = [(points, scene.paints[index]) for points in paths]
-    counts = {
-        "simple_checked": scene.path_count,
-        "simple_repaired": sum(1 for edit in edits.values() if edit),
-        "simple_split": sum(max(len(edit) - 1, 0) for edit in edits.values()),
-        "simple_dropped": sum(1 for edit in edits.values() if not edit),
-        "simple_holes_filled": holes,
-    }
-    return apply_edits(scene, edits), counts
+    return apply_edits(scene, edits), edit_counts("simple", scene, edits, holes)

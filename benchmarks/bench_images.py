@@ -1,0 +1,63 @@
+"""What the benchmark scripts share: where the bench is, which of its images to take, and one
+timed samvg run on an image with its working-size target."""
+
+from __future__ import annotations
+
+import csv
+import os
+import time
+from collections import defaultdict
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import samvg
+from samvg.imaging import resize_longest, to_float_rgb
+from samvg.io import read_image
+from samvg.pipeline import PipelineResult
+
+REPO = Path(__file__).resolve().parents[1]
+BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
+
+
+def bench_entries(
+    per_category: int | None = None, categories: list[str] | None = None
+) -> list[dict[str, str]]:
+    """Manifest rows: all, or the first ``per_category`` of each category (of ``categories``)."""
+    with open(BENCH / "manifest.csv", newline="") as handle:
+        rows = [r for r in csv.DictReader(handle) if not categories or r["category"] in categories]
+    if per_category is None:
+        return rows
+    picked: dict[str, list[dict[str, str]]] = defaultdict(list)
+    for row in rows:
+        if len(picked[row["category"]]) < per_category:
+            picked[row["category"]].append(row)
+    order = categories or sorted(picked)
+    return [row for category in order for row in picked[category]]
+
+
+@dataclass
+class BenchRun:
+    """One samvg run on a bench image: its result, the working-size target, the scale from
+    input to working pixels, seconds, and the working image (uint8)."""
+
+    result: PipelineResult
+    target: np.ndarray
+    scale: float
+    seconds: float
+    working: np.ndarray
+
+    def render(self) -> np.ndarray:
+        """The SVG rendered at the working size, clipped to [0, 1]."""
+        height, width = self.target.shape[:2]
+        return np.clip(self.result.image.render(scale=self.scale)[:height, :width], 0, 1)
+
+
+def run_samvg(entry: dict[str, str], config: samvg.Config) -> BenchRun:
+    original = read_image(BENCH / entry["png"])
+    working, scale = resize_longest(original, config.size)
+    started = time.perf_counter()
+    result = samvg.run(original, config)
+    seconds = time.perf_counter() - started
+    return BenchRun(result, to_float_rgb(working), scale, seconds, working)
