@@ -140,18 +140,31 @@ def _table(records: list[dict[str, Any]], names: list[str]) -> list[str]:
 def write_report(out: Path, names: list[str], report: Path) -> None:
     records = [json.loads(p.read_text()) for p in sorted(out.glob("*.json"))]
     records = [r for r in records if r["setting"] in names]
-    ids = {r["id"] for r in records if r["setting"] == "default"}
-    paired = [r for r in records if r["id"] in ids]
+    settings_of: dict[str, set[str]] = defaultdict(set)
+    for record in records:
+        settings_of[record["id"]].add(record["setting"])
+    paired = [r for r in records if settings_of[r["id"]] >= set(names)]
+    defaults = [r for r in records if r["setting"] == "default"]
     lines = [
         "# Clean geometry (issue 12)",
         "",
-        "`python benchmarks/bench_geometry.py --out OUT` on `../shared/bench` at 512 px. "
+        "`python benchmarks/bench_geometry.py --per-category 4 --settings default,fixed5`, then "
+        "`--settings default` for the rest of `../shared/bench`, at 512 px; records in "
+        "`benchmarks/results/geometry/`. "
         "*default*: the product default (adaptive segments, opaque fills, bounded points, finish "
-        "pass). *fixed5*: the same with 5 segments per path and `--max-paths` set to the "
-        "default's path count. Counts are totals over the images; other columns are means. "
+        "pass). *fixed5*: the same with 5 segments per path when traced and `--max-paths` set to "
+        "the default's path count (an upper bound: it ends with fewer paths on its own; the "
+        "finish pass then redraws repaired outlines, so its segment counts drift from 5). "
+        "Counts are totals over the images; other columns are means. "
         "Self-intersection is tested with shapely on each path of the written SVG (read back, "
         "coordinates rounded as saved), flattened to 0.1 px; outside = more than "
         f"{OUTSIDE_FRACTION:.0%} of the longer side beyond the canvas.",
+        "",
+        f"## The default on {len(defaults)} of the 75 images",
+        "",
+        *_table(defaults, ["default"]),
+        "",
+        f"## Default against fixed5 on the {len(paired) // max(len(names), 1)} images with both",
         "",
         *_table(paired, names),
     ]
