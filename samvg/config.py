@@ -69,6 +69,11 @@ class SegmentOptions:
     """Mask components smaller than this fraction of the image are not traced."""
     max_paths: int | None = None
     """Keep at most this many paths (the masks with the largest impact); None = no limit."""
+    colour_split: bool = True
+    """Split a mask that holds distinct colours into colour-coherent parts painted on top of it
+    (the paper does not)."""
+    split_contrast: float = 10.0
+    """Smallest colour difference (CIELAB ΔE) that splits a mask."""
 
     def __post_init__(self) -> None:
         if self.model not in SAM_MODELS:
@@ -85,6 +90,7 @@ class SegmentOptions:
             raise InputError(f"max paths must be a positive integer, got {self.max_paths!r}")
         _check_non_negative(self, "impact_threshold")
         _check_non_negative(self, "min_area")
+        _check_non_negative(self, "split_contrast")
         _check_radius(self, "uncovered_radius")
         if self.min_area >= 1.0:
             raise InputError(
@@ -323,6 +329,7 @@ PAPER: dict[str, Any] = {
     "translucent": True,
     "margin": None,
     "finish_pass": False,
+    "colour_split": False,
 }
 #: How `Config.fast` differs from the default.
 FAST: dict[str, Any] = {"points_per_side": 16, "size": 384, "iterations": 120, "use_lpips": False}

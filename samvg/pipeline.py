@@ -285,6 +285,7 @@ def _segment(
         amg_components=selection.amg_components,
         kept_masks=selection.kept_after_filter,
         reprompt_masks=selection.reprompt_masks,
+        colour_parts=selection.colour_parts,
     )
     return segmenter, result.masks
 

@@ -68,9 +68,9 @@ def _as_tensor(x: torch.Tensor | np.ndarray, what: str) -> torch.Tensor:
         raise InputError(f"{what} must be a numeric array") from exc
 
 
-def _packed_points(points: torch.Tensor | np.ndarray, offsets: np.ndarray) -> tuple[
-    torch.Tensor, np.ndarray
-]:
+def _packed_points(
+    points: torch.Tensor | np.ndarray, offsets: np.ndarray
+) -> tuple[torch.Tensor, np.ndarray]:
     """Check packed control points (N, 2) against path offsets (P + 1)."""
     pts = _as_tensor(points, "points")
     starts = np.asarray(offsets, dtype=np.int64).reshape(-1)

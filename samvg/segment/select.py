@@ -9,7 +9,8 @@ import numpy as np
 
 from samvg.config import Config
 from samvg.imaging import filled_components, to_float_rgb
-from samvg.segment.impact import filter_by_impact, keep_all, offer_best
+from samvg.segment.colour_split import ColourSplitSettings, colour_parts, lab_image
+from samvg.segment.impact import ImpactCanvas, filter_by_impact, keep_all, offer_best
 from samvg.segment.prompts import uncovered_prompts
 from samvg.segment.segmenter import Segmenter
 
@@ -26,6 +27,8 @@ class SegmentSettings:
     """Pixels."""
     max_paths: int | None
     seed: int
+    colour_split: ColourSplitSettings | None = None
+    """How kept masks are split into colour-coherent parts (None: not split, the paper)."""
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> SegmentSettings:
@@ -38,7 +41,20 @@ class SegmentSettings:
             uncovered_radius=options.uncovered_radius * max(height, width),
             max_paths=options.max_paths,
             seed=config.seed,
+            colour_split=colour_split_settings(config, width, height),
         )
+
+
+def colour_split_settings(config: Config, width: int, height: int) -> ColourSplitSettings | None:
+    """Colour splitting in working pixels for stages 1 and 4 (None when it is off)."""
+    options = config.segment
+    if not options.colour_split:
+        return None
+    return ColourSplitSettings(
+        min_pixels=options.min_pixels(width, height),
+        contrast=options.split_contrast,
+        seed=config.seed,
+    )
 
 
 @dataclass
@@ -51,6 +67,7 @@ class MaskSelection:
     amg_components: int
     kept_after_filter: int
     reprompt_masks: int
+    colour_parts: int = 0
 
 
 def select_masks(
@@ -75,6 +92,9 @@ def select_masks(
             use_filter=settings.filter_by_impact,
             below=True,
         )
+    split = 0
+    if settings.colour_split is not None:
+        split = offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact)
     pairs = list(zip(canvas.kept_masks, canvas.impacts, strict=True))
     if settings.max_paths is not None and len(pairs) > settings.max_paths:
         pairs = sorted(pairs, key=lambda pair: -pair[1])[: settings.max_paths]
@@ -85,4 +105,24 @@ def select_masks(
         amg_components=len(candidates),
         kept_after_filter=len(kept),
         reprompt_masks=reprompt_masks,
+        colour_parts=split,
     )
+
+
+def offer_colour_parts(
+    canvas: ImpactCanvas,
+    settings: ColourSplitSettings,
+    use_filter: bool = True,
+    include_uncovered: bool = True,
+) -> int:
+    """Split every mask kept on ``canvas`` (and, with ``include_uncovered``, the pixels no mask
+    covers, which the background fills) into colour-coherent parts and offer the parts to the
+    canvas, largest first; returns how many were kept."""
+    lab = lab_image(canvas.target)
+    regions = list(canvas.kept_masks)
+    if include_uncovered and not canvas.covered.all():
+        regions.append(~canvas.covered)
+    parts = [part for region in regions for part in colour_parts(region, lab, settings)]
+    parts.sort(key=lambda part: -int(np.count_nonzero(part)))
+    forced = None if use_filter else True
+    return sum(canvas.offer(part, keep=forced).kept for part in parts)

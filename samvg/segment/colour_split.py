@@ -1,0 +1,110 @@
+"""Colour-coherent parts: a mask whose pixels hold two or more distinct colours (a striped sail,
+a suit symbol on a card) gets one part per extra colour, to be painted on top of it, so that no
+path is filled with the blur of two colours.
+
+The colours are found by k-means in CIELAB (scikit-learn ``KMeans``) on a sample of the mask's
+pixels; k grows while each step still removes a large share of the colour variance and the
+centres stay distinct (``contrast``, in ΔE). The mask keeps its most common colour; each
+connected region of another colour (opened with a 3 × 3 square, so that the one- or two-pixel
+anti-aliased seams between colours do not become parts of their own) becomes a part with its
+holes filled. A filled part can again hold other colours (a ring's inside), so parts are split
+the same way, ``depth`` levels deep.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+from skimage.color import rgb2lab
+from sklearn.cluster import KMeans
+
+from samvg.imaging import filled_components
+
+#: k-means runs on at most this many of a mask's pixels (labels are then given to all).
+SAMPLE_PIXELS = 4000
+#: k grows while the next centre removes at least this share of the remaining colour variance.
+MIN_VARIANCE_DROP = 0.4
+_OPENING = np.ones((3, 3), dtype=bool)
+
+
+@dataclass(frozen=True)
+class ColourSplitSettings:
+    """How masks are split into colour-coherent parts (working pixels)."""
+
+    min_pixels: float
+    """Parts smaller than this (after opening) are dropped."""
+    contrast: float = 10.0
+    """Smallest ΔE (CIELAB) between two colours for them to become separate parts."""
+    max_colours: int = 4
+    depth: int = 2
+    seed: int = 0
+
+
+def lab_image(target: np.ndarray) -> np.ndarray:
+    """``target`` (H, W, 3) RGB in [0, 1] in CIELAB, float32."""
+    return rgb2lab(np.clip(target, 0.0, 1.0)).astype(np.float32)
+
+
+def colour_clusters(pixels: np.ndarray, settings: ColourSplitSettings) -> np.ndarray | None:
+    """The distinct colour centres (k, 3) of ``pixels`` (n, 3) in CIELAB, most common first, or
+    None when they are one colour (within ``settings.contrast``)."""
+    if len(pixels) < 2 * settings.min_pixels:
+        return None
+    rng = np.random.default_rng(settings.seed)
+    sample = pixels if len(pixels) <= SAMPLE_PIXELS else rng.choice(pixels, SAMPLE_PIXELS, False)
+    spread = float(((sample - sample.mean(axis=0)) ** 2).sum(axis=1).mean())
+    if spread < (settings.contrast / 2) ** 2:
+        return None
+    best: np.ndarray | None = None
+    inertia = spread * len(sample)
+    distinct = len(np.unique(np.round(sample, 1), axis=0))
+    for k in range(2, min(settings.max_colours, distinct) + 1):
+        kmeans = KMeans(n_clusters=k, n_init=2, random_state=settings.seed).fit(sample)
+        centres = kmeans.cluster_centers_
+        gaps = np.linalg.norm(centres[:, None] - centres[None], axis=2)
+        closest = gaps[~np.eye(k, dtype=bool)].min()
+        if closest < settings.contrast or kmeans.inertia_ > (1 - MIN_VARIANCE_DROP) * inertia:
+            break
+        counts = np.bincount(kmeans.labels_, minlength=k)
+        best, inertia = centres[np.argsort(-counts, kind="stable")], kmeans.inertia_
+    return best
+
+
+def colour_parts(
+    mask: np.ndarray, lab: np.ndarray, settings: ColourSplitSettings, depth: int | None = None
+) -> list[np.ndarray]:
+    """The parts of ``mask`` (H, W) bool whose colour differs from the mask's main colour, as
+    filled full-size masks, each followed by its own parts (``depth`` levels)."""
+    depth = settings.depth if depth is None else depth
+    if depth <= 0:
+        return []
+    rows, cols = np.nonzero(mask)
+    if len(rows) == 0:
+        return []
+    pixels = lab[rows, cols]
+    centres = colour_clusters(pixels, settings)
+    if centres is None:
+        return []
+    nearest = np.argmin(((pixels[:, None, :] - centres[None]) ** 2).sum(axis=2), axis=1)
+    top, left = rows.min(), cols.min()
+    window = np.full((rows.max() - top + 1, cols.max() - left + 1), -1, dtype=np.int16)
+    window[rows - top, cols - left] = nearest
+    parts: list[np.ndarray] = []
+    for cluster in range(1, len(centres)):
+        region = ndimage.binary_opening(window == cluster, _OPENING)
+        for part in filled_components(region, settings.min_pixels):
+            full = np.zeros(mask.shape, dtype=bool)
+            full[top : top + part.shape[0], left : left + part.shape[1]] = part
+            for found in (full, *colour_parts(full, lab, settings, depth - 1)):
+                if not any(_same_region(found, other) for other in parts):
+                    parts.append(found)
+    return parts
+
+
+def _same_region(first: np.ndarray, second: np.ndarray, overlap: float = 0.9) -> bool:
+    """Whether two masks cover nearly the same pixels (a disc found inside a ring's filled part
+    and again as a region of its own colour)."""
+    shared = np.count_nonzero(first & second)
+    return shared >= overlap * max(np.count_nonzero(first), np.count_nonzero(second))
