@@ -144,6 +144,8 @@ def _config(arguments: argparse.Namespace) -> Config:
         "threads": arguments.threads,
         "lpips_weights": arguments.lpips_weights,
         "missing_rounds": arguments.missing_rounds,
+        "paths": arguments.paths,
+        "detail": arguments.detail,
         "tolerance": arguments.tolerance,
         "colors": arguments.colors,
     }
@@ -395,6 +397,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
     """The ``vectorize`` options that tune the method (paths, segments, fitting, SAM)."""
+    vectorize.add_argument(
+        "--paths",
+        type=int,
+        help="exactly this many paths, when the image holds that much detail (default: as "
+        "--detail decides)",
+    )
+    vectorize.add_argument(
+        "--detail",
+        type=float,
+        help="0 to 1: how much detail to chase when --paths is not given; stage 4 adds rounds "
+        "until one lowers the error by less than 10%% (0), 1%% (0.5, the default), 0.1%% (1)",
+    )
     vectorize.add_argument("--max-paths", type=int, help="at most this many paths")
     vectorize.add_argument(
         "--segments",
@@ -442,7 +456,9 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
     vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
     vectorize.add_argument("--crops", type=int, help="SAM crop layers (test-time augmentation)")
     vectorize.add_argument(
-        "--missing-rounds", type=int, help="rounds of stage 4, adding missing parts (default 1)"
+        "--missing-rounds",
+        type=int,
+        help="rounds of stage 4, adding missing parts (default: as --detail decides; paper: 1)",
     )
     vectorize.add_argument("--no-lpips", action="store_true", help="optimize MSE + Xing only")
     vectorize.add_argument("--lpips-weights", help="LPIPS weight file (flat state dict)")

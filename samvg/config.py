@@ -185,8 +185,15 @@ class MissingOptions:
     """Stage 4: paths added where the optimized render still differs from the image."""
 
     missing_components: bool = True
-    missing_rounds: int = 1
-    """Rounds of stage 4 (error map → SAM → trace → fit); the paper runs one."""
+    missing_rounds: int | None = None
+    """Rounds of stage 4 (error map → SAM → trace → fit); the paper runs one. None: rounds until
+    one lowers the error by less than the ``detail`` tolerance."""
+    detail: float = 0.5
+    """How much detail the automatic rounds chase, from 0 (a round must lower the error by 10 %)
+    to 1 (by 0.1 %); 0.5 stops at rounds that gain less than 1 %."""
+    paths: int | None = None
+    """Exactly this many paths when the image holds that much detail: stage 4 grows the scene to
+    a larger pool, then the paths of least impact are removed (None: as ``detail`` decides)."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015
@@ -195,14 +202,29 @@ class MissingOptions:
     fit: small parts (eyes) gain little as flat colour, so the bar is lower than in stage 1."""
 
     def __post_init__(self) -> None:
-        _check_integer(self, "missing_rounds", 0)
+        if self.missing_rounds is not None:
+            _check_integer(self, "missing_rounds", 0)
+        if self.paths is not None:
+            _check_integer(self, "paths", 1)
+        if (
+            isinstance(self.detail, bool)
+            or not isinstance(self.detail, (int, float))
+            or not (0.0 <= self.detail <= 1.0)
+        ):
+            raise InputError(f"detail must be a number from 0 to 1, got {self.detail!r}")
         _check_non_negative(self, "missing_threshold")
         _check_non_negative(self, "missing_impact_threshold")
         _check_radius(self, "missing_radius")
 
     @property
-    def rounds(self) -> int:
+    def rounds(self) -> int | None:
+        """Rounds of stage 4 to run; None: as many as ``detail`` (or ``paths``) asks."""
         return self.missing_rounds if self.missing_components else 0
+
+    @property
+    def gain_tolerance(self) -> float:
+        """The fraction of the error a round must remove for the automatic rounds to go on."""
+        return 0.1 * 10.0 ** (-2.0 * self.detail)
 
 
 _GROUPS = {
@@ -330,6 +352,7 @@ PAPER: dict[str, Any] = {
     "margin": None,
     "finish_pass": False,
     "colour_split": False,
+    "missing_rounds": 1,
 }
 #: How `Config.fast` differs from the default.
 FAST: dict[str, Any] = {"points_per_side": 16, "size": 384, "iterations": 120, "use_lpips": False}

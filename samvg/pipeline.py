@@ -8,6 +8,7 @@ Each stage owns its settings: they are derived here once from `Config`, in worki
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import time
 from collections.abc import Callable, Iterator
@@ -31,8 +32,10 @@ from samvg.finish.outline import polygon_areas
 from samvg.imaging import alpha_channel, resize_longest, to_float_rgb, to_rgb_uint8
 from samvg.io import read_image_with_alpha
 from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
-from samvg.missing import MissingSettings, add_missing
+from samvg.missing import MissingSettings
+from samvg.missing.stage import BUDGET_POOL, MAX_AUTO_ROUNDS, add_missing_rounds
 from samvg.optimize import FitSettings, fit_scene
+from samvg.optimize.reduce import reduce_paths
 from samvg.optimize.reshape import reshape_scene
 from samvg.sam import SPECS
 from samvg.scene import Frame, Scene
@@ -235,37 +238,58 @@ def _run_stages(
     torch.manual_seed(config.seed)
     segmenter, masks = _segment(inputs, config, result, report)
     trace_settings = TraceSettings.from_config(config, width, height)
-    with _timed(result, "trace"):
-        report("trace", 0, 1)
-        traced = _within(trace_scene(masks, inputs.target, trace_settings), config)
-        background = (
-            None if inputs.alpha is not None else uncovered_background(masks, inputs.target)
-        )
-        scene = replace(traced, background=background, frame=inputs.frame)
-        report("trace", 1, 1)
-    result.initial = VectorImage.from_scene(scene)
-    result.counts["paths_initial"] = scene.path_count
+    scene = _trace(masks, inputs, trace_settings, config, result, report)
     with _timed(result, "optimize"):
         on_step = _progress_of(report, "optimize", fit.steps)
         scene = fit_scene(scene, inputs.target, fit, on_step).scene
     result.optimized = VectorImage.from_scene(scene)
     missing = MissingSettings.from_config(config, width, height)
-    if missing.rounds and config.trace.adaptive and config.trace.reshape:
+    if missing.rounds != 0 and config.trace.adaptive and config.trace.reshape:
         with _timed(result, "reshape"):
             scene, counts = reshape_scene(
                 scene, config.trace.tolerance, config.trace.max_segments, _box(config, inputs)
             )
         result.counts.update(counts)
-    scene = _add_missing(scene, inputs, segmenter, (missing, trace_settings, fit), result, report)
+    stages = (missing, trace_settings, fit)
+    scene = _add_missing(scene, inputs, segmenter, stages, config, result, report)
+    budget = config.missing.paths
+    if budget is not None and config.finish.finish_pass:
+        scene = _finish_pass(scene, config, inputs, result, report)  # merges and hidden go first
+    if budget is not None:
+        scene = _reduce(scene, inputs, fit, budget, result)
     if config.finish.finish_pass:
-        with _timed(result, "finish"):
-            report("finish", 0, 1)
-            finished = finish_scene(scene, _finish_settings(config, inputs))
-            scene = _within(finished.scene, config, by_area=True)
-            result.counts.update(finished.counts)
-            result.notes.append(_finish_note(finished.counts))
-            report("finish", 1, 1)
+        scene = _finish_pass(scene, config, inputs, result, report)
+    if budget is not None:
+        scene = _meet_budget(scene, inputs, budget, result)
     _finish(scene, inputs.target, result, simple=config.finish.finish_pass)
+
+
+def _finish_pass(
+    scene: Scene, config: Config, inputs: _Inputs, result: PipelineResult, report: ProgressCallback
+) -> Scene:
+    with _timed(result, "finish"):
+        report("finish", 0, 1)
+        finished = finish_scene(scene, _finish_settings(config, inputs))
+        scene = _within(finished.scene, config, by_area=True)
+        for name, count in finished.counts.items():
+            result.counts[name] = result.counts.get(name, 0) + count
+        result.notes.append(_finish_note(finished.counts))
+        report("finish", 1, 1)
+    return scene
+
+
+def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineResult) -> Scene:
+    """Paths the finish pass split off beyond the budget are removed (least cost first); a
+    scene short of the budget says why."""
+    if scene.path_count > budget:
+        scene, removed = reduce_paths(scene, inputs.target, budget)
+        result.counts["reduced"] = result.counts.get("reduced", 0) + removed
+    if scene.path_count < budget:
+        result.notes.append(
+            f"{scene.path_count} paths, not {budget}: no further path lowers the error "
+            "measurably (or the finish pass merged touching paths of one colour)"
+        )
+    return scene
 
 
 def _segment(
@@ -317,26 +341,48 @@ def _add_missing(
     inputs: _Inputs,
     segmenter: Segmenter,
     settings: tuple[MissingSettings, TraceSettings, FitSettings],
+    config: Config,
     result: PipelineResult,
     report: ProgressCallback,
 ) -> Scene:
-    """Stage 4, as many rounds as asked."""
-    missing, trace_settings, fit = settings
-    result.counts.update(missing_prompts=0, missing_paths=0)
-    for _ in range(missing.rounds):
-        report("missing", 0, 1)
-        on_step = _progress_of(report, "refine", fit.steps)
-        round_ = add_missing(
-            scene, inputs.target, segmenter, missing, trace_settings, fit, on_step, inputs.alpha
-        )
-        report("missing", 1, 1)
-        scene = round_.scene
-        result.missing_map, result.missing_prompts = round_.error_map, round_.prompts
-        result.counts["missing_prompts"] += len(round_.prompts)
-        result.counts["missing_paths"] += round_.added
-        for stage, seconds in round_.timings.items():
-            result.timings[stage] = result.timings.get(stage, 0.0) + seconds
-    return scene
+    """Stage 4: as many rounds as asked, as ``detail`` decides, or until a path budget's pool is
+    full; then, under a budget, the paths of least impact are removed and the rest fitted."""
+    budget = config.missing.paths
+    pool = math.ceil(BUDGET_POOL * budget) if budget is not None else None
+    planned = settings[0].rounds
+    total = planned if planned is not None else MAX_AUTO_ROUNDS
+    report("missing", 0, total)
+    done = add_missing_rounds(
+        scene,
+        inputs.target,
+        segmenter,
+        settings,
+        pool,
+        on_round=lambda count, _round: report("missing", min(count, total), total),
+        alpha=inputs.alpha,
+    )
+    report("missing", total, total)
+    result.missing_map, result.missing_prompts = done.error_map, done.prompts
+    result.counts.update(
+        missing_rounds=done.rounds, missing_prompts=done.prompt_count, missing_paths=done.added
+    )
+    for stage, seconds in done.timings.items():
+        result.timings[stage] = result.timings.get(stage, 0.0) + seconds
+    if done.rounds:
+        result.notes.append(f"stage 4: {done.rounds} rounds, {done.added} paths ({done.stopped})")
+    return done.scene
+
+
+def _reduce(
+    scene: Scene, inputs: _Inputs, fit: FitSettings, budget: int, result: PipelineResult
+) -> Scene:
+    """The scene cut to ``budget`` paths (those of least removal cost go) and fitted again."""
+    if scene.path_count <= budget:
+        return scene
+    with _timed(result, "reduce"):
+        scene, removed = reduce_paths(scene, inputs.target, budget)
+        result.counts["reduced"] = result.counts.get("reduced", 0) + removed
+        return fit_scene(scene, inputs.target, fit).scene
 
 
 def _box(config: Config, inputs: _Inputs) -> tuple[float, float, float, float]:

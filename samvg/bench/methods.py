@@ -78,7 +78,8 @@ def _baseline(name: str) -> Callable[[MethodRun], Vectorized]:
                 single_run_s=round(result.run_seconds, 3),
             )
             return result
-        phases = 1 + job.config.missing.rounds
+        rounds = job.config.missing.rounds
+        phases = 1 + (1 if rounds is None else rounds)  # automatic rounds: as the paper's one
         steps = phases * job.config.fit.iterations
         job.details["steps"] = steps
         return run_baseline(

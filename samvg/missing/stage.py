@@ -1,20 +1,32 @@
-"""SAMVG stage 4, one round: error map → prompts → SAM → filter by impact against the current
-render → trace → fit the enlarged scene. The pipeline calls it as many rounds as asked."""
+"""SAMVG stage 4: error map → prompts → SAM (and, by default, the colour-coherent regions the
+render gets wrong) → filter by impact against the current render → trace → fit the enlarged
+scene. `add_missing` is one round; `add_missing_rounds` repeats it as many times as asked, until
+a round gains less than the detail tolerance, or until a path budget's pool is full."""
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from samvg.config import Config
+from samvg.imaging import error_map
 from samvg.missing.prompts import missing_component_map, missing_component_prompts
 from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import StepCallback
 from samvg.scene import Scene
 from samvg.segment import ImpactCanvas, Segmenter, offer_best
+from samvg.segment.colour_split import ColourSplitSettings, colour_regions, lab_image
+from samvg.segment.select import colour_split_settings, offer_colour_parts
 from samvg.trace.stage import TraceSettings, drop_transparent, trace_scene
+
+#: Rounds the automatic detail runs at most (each one fits the whole scene again).
+MAX_AUTO_ROUNDS = 6
+#: A path budget's pool: stage 4 grows the scene to this many times the budget before the
+#: paths of least impact are removed.
+BUDGET_POOL = 1.25
 
 
 @dataclass(frozen=True)
@@ -27,9 +39,16 @@ class MissingSettings:
     impact_threshold: float
     filter_by_impact: bool
     min_pixels: float
-    rounds: int
+    rounds: int | None
+    """Rounds to run; None: until a round lowers the error by less than ``gain_tolerance``."""
     max_paths: int | None = None
     """The scene's path limit (`SegmentOptions.max_paths`): a round adds at most what is left."""
+    colour_split: ColourSplitSettings | None = None
+    """Also offer the colour-coherent regions the render gets wrong (None: SAM's masks only)."""
+    pixel_error: float = 0.25
+    """A pixel is wrong when its error (sum over RGB, in [0, 3]) reaches this."""
+    gain_tolerance: float = 0.01
+    """The automatic rounds stop when a round lowers the MSE by less than this fraction."""
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> MissingSettings:
@@ -42,6 +61,8 @@ class MissingSettings:
             min_pixels=config.segment.min_pixels(width, height),
             rounds=options.rounds,
             max_paths=config.segment.max_paths,
+            colour_split=colour_split_settings(config, width, height),
+            gain_tolerance=options.gain_tolerance,
         )
 
 
@@ -76,11 +97,27 @@ def missing_masks(
         use_filter=settings.filter_by_impact,
         below=False,
     )
+    if settings.colour_split is not None:
+        offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact, False)
+        offer_wrong_regions(canvas, render, settings.pixel_error, settings.colour_split)
     masks = canvas.kept_masks
     if limit is not None and len(masks) > limit:
         order = np.argsort(-np.asarray(canvas.impacts), kind="stable")[:limit]
         masks = [masks[index] for index in sorted(order)]
     return sorted(masks, key=lambda mask: -int(mask.sum()))
+
+
+def offer_wrong_regions(
+    canvas: ImpactCanvas, render: np.ndarray, pixel_error: float, split: ColourSplitSettings
+) -> int:
+    """Offer ``canvas`` the colour-coherent regions of the pixels ``render`` gets wrong (text,
+    stripes, small marks SAM's prompts missed), largest first; returns how many were kept."""
+    wrong = error_map(canvas.target, render) >= pixel_error
+    if np.count_nonzero(wrong) < split.min_pixels:
+        return 0
+    regions = colour_regions(wrong, lab_image(canvas.target), split)
+    regions.sort(key=lambda region: -int(np.count_nonzero(region)))
+    return sum(canvas.offer(region).kept for region in regions)
 
 
 def room_left(scene: Scene, settings: MissingSettings) -> int | None:
@@ -119,3 +156,71 @@ def add_missing(
         result.scene = fit_scene(scene.stacked(added), target, fit, on_step).scene
         result.timings["refine"] = time.perf_counter() - clock
     return result
+
+
+@dataclass
+class MissingRounds:
+    """What the rounds of stage 4 did: the final scene, the last round's error map and prompts,
+    rounds run, paths added, prompts used, seconds spent, and why they stopped."""
+
+    scene: Scene
+    error_map: np.ndarray | None = None
+    prompts: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    rounds: int = 0
+    added: int = 0
+    prompt_count: int = 0
+    timings: dict[str, float] = field(default_factory=dict)
+    stopped: str = ""
+
+
+def add_missing_rounds(
+    scene: Scene,
+    target: np.ndarray,
+    segmenter: Segmenter,
+    stages: tuple[MissingSettings, TraceSettings, FitSettings],
+    pool: int | None = None,
+    on_round: Callable[[int, MissingRound], None] | None = None,
+    alpha: np.ndarray | None = None,
+) -> MissingRounds:
+    """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
+    less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`). With a ``pool`` (a path
+    budget), rounds take the candidates of largest impact, however small, until the scene has
+    ``pool`` paths or a round finds nothing more (at most ``2 * MAX_AUTO_ROUNDS``)."""
+    settings, trace, fit = stages
+    if pool is not None:
+        limit = pool if settings.max_paths is None else min(pool, settings.max_paths)
+        settings = replace(settings, impact_threshold=0.0, max_paths=limit)
+    planned = settings.rounds
+    most = planned if planned is not None else MAX_AUTO_ROUNDS * (2 if pool else 1)
+    done = MissingRounds(scene)
+    error = _mse(scene, target)
+    while done.rounds < most:
+        if pool is not None and scene.path_count >= (settings.max_paths or pool):
+            done.stopped = f"the pool of {pool} paths is full"
+            break
+        round_ = add_missing(scene, target, segmenter, settings, trace, fit, None, alpha)
+        done.rounds += 1
+        done.added += round_.added
+        done.prompt_count += len(round_.prompts)
+        done.error_map, done.prompts = round_.error_map, round_.prompts
+        for stage, seconds in round_.timings.items():
+            done.timings[stage] = done.timings.get(stage, 0.0) + seconds
+        if on_round is not None:
+            on_round(done.rounds, round_)
+        scene = round_.scene
+        now = _mse(scene, target)
+        gain = (error - now) / max(error, 1e-12)
+        error = now
+        if round_.added == 0:
+            done.stopped = "no region left that a new path improves"
+            break
+        if planned is None and pool is None and gain < settings.gain_tolerance:
+            done.stopped = f"round {done.rounds} lowered the error by {gain:.1%}"
+            break
+    done.scene = scene
+    done.stopped = done.stopped or f"{done.rounds} rounds"
+    return done
+
+
+def _mse(scene: Scene, target: np.ndarray) -> float:
+    return float(np.mean((scene.render() - target) ** 2))

@@ -78,26 +78,40 @@ def colour_parts(
     """The parts of ``mask`` (H, W) bool whose colour differs from the mask's main colour, as
     filled full-size masks, each followed by its own parts (``depth`` levels)."""
     depth = settings.depth if depth is None else depth
-    if depth <= 0:
-        return []
+    return _cluster_parts(mask, lab, settings, depth, with_main=False)
+
+
+def colour_regions(
+    region: np.ndarray, lab: np.ndarray, settings: ColourSplitSettings
+) -> list[np.ndarray]:
+    """Every colour-coherent part of ``region`` (the main colour's too), each followed by its own
+    parts: the candidate shapes of an area the current paths get wrong."""
+    return _cluster_parts(region, lab, settings, settings.depth, with_main=True)
+
+
+def _cluster_parts(
+    mask: np.ndarray, lab: np.ndarray, settings: ColourSplitSettings, depth: int, with_main: bool
+) -> list[np.ndarray]:
     rows, cols = np.nonzero(mask)
-    if len(rows) == 0:
+    if depth <= 0 or len(rows) == 0:
         return []
     pixels = lab[rows, cols]
     centres = colour_clusters(pixels, settings)
     if centres is None:
-        return []
+        if not with_main:
+            return []
+        centres = pixels.mean(axis=0, keepdims=True)
     nearest = np.argmin(((pixels[:, None, :] - centres[None]) ** 2).sum(axis=2), axis=1)
     top, left = rows.min(), cols.min()
     window = np.full((rows.max() - top + 1, cols.max() - left + 1), -1, dtype=np.int16)
     window[rows - top, cols - left] = nearest
     parts: list[np.ndarray] = []
-    for cluster in range(1, len(centres)):
+    for cluster in range(0 if with_main else 1, len(centres)):
         region = ndimage.binary_opening(window == cluster, _OPENING)
         for part in filled_components(region, settings.min_pixels):
             full = np.zeros(mask.shape, dtype=bool)
             full[top : top + part.shape[0], left : left + part.shape[1]] = part
-            for found in (full, *colour_parts(full, lab, settings, depth - 1)):
+            for found in (full, *_cluster_parts(full, lab, settings, depth - 1, False)):
                 if not any(_same_region(found, other) for other in parts):
                     parts.append(found)
     return parts
@@ -107,4 +121,4 @@ def _same_region(first: np.ndarray, second: np.ndarray, overlap: float = 0.9) ->
     """Whether two masks cover nearly the same pixels (a disc found inside a ring's filled part
     and again as a region of its own colour)."""
     shared = np.count_nonzero(first & second)
-    return shared >= overlap * max(np.count_nonzero(first), np.count_nonzero(second))
+    return bool(shared >= overlap * max(np.count_nonzero(first), np.count_nonzero(second)))
