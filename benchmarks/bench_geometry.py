@@ -21,9 +21,10 @@ from typing import Any
 
 import numpy as np
 import shapely
-from bench_images import REPO, bench_entries, run_samvg
+from bench_images import REPO, bench_entries, run_samvg, vtracer_default
 
 import samvg
+from samvg.baselines import render_svg
 from samvg.finish import flatten_paths
 from samvg.io import atomic_write_text
 from samvg.metrics import load_lpips, lpips_distance
@@ -61,7 +62,9 @@ def geometry_checks(scene: Scene, opaque_input: bool) -> dict[str, Any]:
     }
 
 
-def run_one(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dict[str, Any]:
+def run_one(
+    entry: dict[str, str], config: samvg.Config, lpips: Any, with_vtracer: bool = False
+) -> dict[str, Any]:
     run = run_samvg(entry, config)
     render = run.render()
     written = samvg.VectorImage.from_svg(run.result.image.to_svg())  # what the SVG file holds
@@ -74,6 +77,15 @@ def run_one(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dict[str
         lpips=lpips_distance(lpips, render, run.target),
         seconds=run.seconds,
     )
+    if with_vtracer:  # VTracer's default settings on the same working image
+        svg = vtracer_default(run.working)
+        theirs = np.clip(render_svg(svg, render.shape[1], render.shape[0]), 0, 1)
+        record.update(
+            vtracer_paths=svg.count("<path"),
+            vtracer_bytes=len(svg.encode()),
+            vtracer_mse=float(np.mean((theirs - run.target) ** 2)),
+            vtracer_lpips=lpips_distance(lpips, theirs, run.target),
+        )
     return record
 
 
@@ -99,7 +111,7 @@ def run_all(entries: list[dict[str, str]], out: Path, names: list[str]) -> None:
                 if not reference.exists():
                     continue
                 paths = json.loads(reference.read_text())["paths"]
-            record = run_one(entry, configs(name, paths), lpips)
+            record = run_one(entry, configs(name, paths), lpips, with_vtracer=name == "default")
             record["setting"] = name
             atomic_write_text(record_file, json.dumps(record, indent=1))
             print(json.dumps(record), flush=True)

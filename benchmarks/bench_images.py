@@ -4,6 +4,7 @@ timed samvg run on an image with its working-size target."""
 from __future__ import annotations
 
 import csv
+import io
 import os
 import time
 from collections import defaultdict
@@ -11,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 import samvg
 from samvg.imaging import resize_longest, to_float_rgb
@@ -61,3 +63,12 @@ def run_samvg(entry: dict[str, str], config: samvg.Config) -> BenchRun:
     result = samvg.run(original, config)
     seconds = time.perf_counter() - started
     return BenchRun(result, to_float_rgb(working), scale, seconds, working)
+
+
+def vtracer_default(image: np.ndarray) -> str:
+    """VTracer's SVG of a uint8 image with its default settings."""
+    import vtracer  # the bench extra
+
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, format="PNG")
+    return vtracer.convert_raw_image_to_svg(buffer.getvalue(), img_format="png")

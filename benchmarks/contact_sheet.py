@@ -10,12 +10,11 @@ sheets must not be committed (the bench's licences forbid copies of them in the 
 from __future__ import annotations
 
 import argparse
-import io
 import sys
 from pathlib import Path
 
 import numpy as np
-from bench_images import REPO, bench_entries, run_samvg
+from bench_images import REPO, bench_entries, run_samvg, vtracer_default
 from PIL import Image, ImageDraw
 
 import samvg
@@ -24,15 +23,6 @@ from samvg.baselines import render_svg
 CELL = 256
 CAPTION = 30
 PRESETS = {"default": samvg.Config, "paper": samvg.Config.paper, "fast": samvg.Config.fast}
-
-
-def vtracer_default(image: np.ndarray) -> str:
-    """VTracer's SVG of a uint8 image with its default settings."""
-    import vtracer  # the bench extra
-
-    buffer = io.BytesIO()
-    Image.fromarray(image).save(buffer, format="PNG")
-    return vtracer.convert_raw_image_to_svg(buffer.getvalue(), img_format="png")
 
 
 def cell(picture: np.ndarray, caption: str) -> Image.Image:

@@ -77,3 +77,14 @@ def test_setting_names_are_unique_and_never_a_group_name():
 
     assert not set(_GROUP_OF) & (set(_GROUPS) | set(_RUN))
     assert not Config.paper().finish.finish_pass and Config().finish.finish_pass
+
+
+def test_detail_and_paths_are_checked_and_the_paper_runs_one_round():
+    assert Config().missing.rounds is None and Config.paper().missing.rounds == 1
+    assert Config.paper().segment.colour_split is False and Config().segment.colour_split
+    tolerances = [Config(detail=d).missing.gain_tolerance for d in (0.0, 0.5, 1.0)]
+    assert tolerances == pytest.approx([0.1, 0.01, 0.001])
+    assert Config(paths=64).missing.paths == 64
+    for bad in ({"detail": 1.5}, {"detail": -0.1}, {"detail": "high"}, {"paths": 0}):
+        with pytest.raises(InputError, match="detail|paths"):
+            Config(**bad)

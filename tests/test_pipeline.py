@@ -212,3 +212,21 @@ def test_default_output_is_opaque_bounded_and_simple(emoji, sam_checkpoint):
     assert scene.points.min() >= -margin and scene.points.max() <= 96 + margin
     paper = samvg.run(emoji, Config.paper(checkpoint=str(sam_checkpoint), **QUICK))
     assert all(k == 5 for k in paper.image.scene.segment_counts())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("budget", [4, 9])
+def test_a_path_budget_is_met_exactly(emoji, sam_checkpoint, budget):
+    result = samvg.run(emoji, Config(checkpoint=str(sam_checkpoint), paths=budget, **QUICK))
+    assert result.counts["paths"] == len(result.image.paths) == budget
+
+
+@pytest.mark.slow
+def test_the_sample_keeps_its_stripes_at_least_as_well_as_vtracer(sam_checkpoint):
+    """The README's sample at the quick preset: the striped sail, both boats and the sun are
+    kept (MSE at most VTracer's default, 4.3e-3 on this image, measured in
+    benchmarks/results/detail.md), and detail beyond the first round was added."""
+    sample = samvg.__path__[0] + "/samples/sailing_sunset.png"
+    result = samvg.run(sample, Config.fast(checkpoint=str(sam_checkpoint)))
+    assert result.mse <= 4.3e-3
+    assert result.counts["colour_parts"] > 0 and result.counts["missing_rounds"] >= 2

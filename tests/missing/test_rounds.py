@@ -1,0 +1,77 @@
+"""Stage 4 repeated: colour regions the render gets wrong, automatic rounds that stop when
+nothing more helps, and a path budget's pool."""
+
+import numpy as np
+
+from samvg.missing.stage import MissingSettings, add_missing_rounds, offer_wrong_regions
+from samvg.optimize import FitSettings
+from samvg.scene import Scene
+from samvg.segment import ImpactCanvas
+from samvg.segment.colour_split import ColourSplitSettings
+from samvg.trace.stage import TraceSettings
+
+RED, BLUE = (0.9, 0.1, 0.1), (0.1, 0.2, 0.8)
+SPLIT = ColourSplitSettings(min_pixels=8)
+
+
+class SilentSegmenter:
+    """SAM's stand-in that finds nothing: only the colour regions can add paths."""
+
+    def prompt(self, points: np.ndarray) -> list[list[np.ndarray]]:
+        return [[] for _ in points]
+
+
+def target() -> np.ndarray:
+    image = np.ones((64, 64, 3), np.float32)
+    image[6:26, 6:26] = RED
+    image[36:50, 30:44] = BLUE
+    image[40:46, 8:14] = RED
+    return image
+
+
+def settings(rounds: int | None = None, max_paths: int | None = None) -> MissingSettings:
+    return MissingSettings(
+        radius=1.0,
+        threshold=0.5,
+        impact_threshold=1e-4,
+        filter_by_impact=True,
+        min_pixels=8,
+        rounds=rounds,
+        max_paths=max_paths,
+        colour_split=SPLIT,
+    )
+
+
+def blank_scene() -> Scene:
+    return Scene(64, 64, background=(1.0, 1.0, 1.0))
+
+
+STAGES = (settings(), TraceSettings(4, 8, tolerance=1.0), FitSettings(steps=0))
+
+
+def test_wrong_regions_become_one_candidate_per_colour_coherent_area():
+    image = target()
+    canvas = ImpactCanvas(image, 1e-4, start=np.ones_like(image))
+    kept = offer_wrong_regions(canvas, np.ones_like(image), 0.25, SPLIT)
+    assert kept == 3
+    for mask in canvas.kept_masks:
+        colours = np.unique(image[mask], axis=0)
+        assert len(colours) == 1  # never the blur of two colours
+
+
+def test_automatic_rounds_stop_when_no_region_is_left():
+    done = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), STAGES)
+    assert done.added == 3 and done.scene.path_count == 3
+    assert done.rounds == 2 and "no region left" in done.stopped
+    assert np.mean((done.scene.render() - target()) ** 2) < 1e-3
+
+
+def test_a_set_number_of_rounds_runs_exactly_that_many():
+    stages = (settings(rounds=1), *STAGES[1:])
+    done = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), stages)
+    assert done.rounds == 1 and done.added == 3
+
+
+def test_a_budget_pool_stops_growing_when_full():
+    done = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), STAGES, pool=2)
+    assert done.scene.path_count == 2 and "pool of 2 paths is full" in done.stopped

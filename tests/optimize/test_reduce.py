@@ -1,0 +1,49 @@
+"""Reducing a scene to a path budget by removal cost."""
+
+import numpy as np
+
+from samvg.optimize.reduce import reduce_paths, removal_costs
+from samvg.scene import FlatPaint, Scene
+
+
+def square(left: float, top: float, side: float) -> np.ndarray:
+    corners = np.array([[left, top], [left + side, top], [left + side, top + side],
+                        [left, top + side]], float)  # fmt: skip
+    points = []
+    for start, end in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+        points += [start, start + (end - start) / 3, start + 2 * (end - start) / 3]
+    return np.asarray(points)
+
+
+BLUE, RED = FlatPaint((0.1, 0.2, 0.8)), FlatPaint((0.9, 0.1, 0.1))
+
+
+def scene_and_target() -> tuple[Scene, np.ndarray]:
+    """A big blue square, a red square hidden under it, a small red square on top, and a red
+    square of the wrong colour where the target is white."""
+    paths = [
+        (square(8, 8, 10), RED),  # hidden under the blue square
+        (square(4, 4, 30), BLUE),
+        (square(10, 10, 6), RED),
+        (square(44, 44, 12), RED),  # harmful: the target is white there
+    ]
+    scene = Scene.from_paths(64, 64, paths, background=(1.0, 1.0, 1.0))
+    target = scene.subset([1, 2]).render()
+    return scene, target
+
+
+def test_removal_costs_rank_hidden_and_harmful_paths_below_visible_ones():
+    scene, target = scene_and_target()
+    costs = removal_costs(scene, target)
+    assert costs[0] == 0.0  # hidden: removing it changes nothing
+    assert costs[3] < 0.0  # harmful: removing it helps
+    assert costs[1] > costs[2] > 0.0  # the big square matters most
+
+
+def test_reduce_paths_keeps_the_paths_that_matter_in_paint_order():
+    scene, target = scene_and_target()
+    reduced, removed = reduce_paths(scene, target, 2)
+    assert removed == 2 and reduced.path_count == 2
+    assert np.array_equal(reduced.points, scene.subset([1, 2]).points)
+    assert np.allclose(reduced.render(), target)
+    assert reduce_paths(scene, target, 10)[0].path_count == 4  # under budget: unchanged
