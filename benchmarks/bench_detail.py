@@ -1,0 +1,165 @@
+"""Detail at any path budget (issue 11): samvg at N paths against VTracer tuned to N paths, the
+LIVE-style baseline and random init (diffvg) at N; a rate-distortion sweep for photos and
+paintings; and the report, which also holds the default against VTracer's default settings
+(from the records of ``bench_geometry.py --settings default``).
+
+    python benchmarks/bench_detail.py budget --per-category 4 --paths 16,64
+    python benchmarks/bench_detail.py rate --per-category 4
+    python benchmarks/bench_detail.py report
+
+Every run is one JSON record in ``benchmarks/results/detail/`` (a rerun skips what is there, so
+a long run resumes); the report goes to ``benchmarks/results/detail.md`` and the
+rate-distortion plot to ``benchmarks/results/detail_rate.png``. All images are vectorized at
+512 px; MSE and LPIPS are measured at that working size.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import time
+from typing import Any
+
+import numpy as np
+from bench_images import BENCH, REPO, bench_entries, run_samvg
+from PIL import Image
+
+import samvg
+from samvg.baselines import render_svg, run_baseline
+from samvg.baselines.vtracer_baseline import trace_once
+from samvg.imaging import resize_longest, to_float_rgb
+from samvg.io import atomic_write_text, read_image
+from samvg.metrics import load_lpips, lpips_distance
+from samvg.optimize import FitSettings
+
+RECORDS = REPO / "benchmarks/results/detail"
+GEOMETRY = REPO / "benchmarks/results/geometry"
+FLAT_ART = ("emoji", "icon", "clipart", "digital_art")
+#: Baselines that optimize get samvg's losses and the paper's two phases of steps.
+BASELINE_STEPS = 2 * samvg.Config().fit.iterations
+#: VTracer settings for the rate-distortion sweep: (filter_speckle, color_precision,
+#: layer_difference), from finest to coarsest; (4, 6, 16) is VTracer's default.
+VTRACER_SWEEP = ((2, 7, 8), (4, 6, 16), (8, 5, 24), (16, 4, 32), (32, 3, 48))
+
+
+def working_image(entry: dict[str, str]) -> np.ndarray:
+    return resize_longest(read_image(BENCH / entry["png"]), 512)[0]
+
+
+def measured(picture: np.ndarray, target: np.ndarray, lpips: Any) -> dict[str, float]:
+    picture = np.clip(picture, 0.0, 1.0)
+    return {
+        "mse": float(np.mean((picture - target) ** 2)),
+        "lpips": lpips_distance(lpips, picture, target),
+    }
+
+
+def samvg_record(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dict[str, Any]:
+    run = run_samvg(entry, config)
+    svg = run.result.image.to_svg()
+    return {
+        "paths": run.result.counts.get("paths", 0),
+        "svg_bytes": len(svg.encode()),
+        "seconds": run.seconds,
+        **measured(run.render(), run.target, lpips),
+    }
+
+
+def baseline_record(entry: dict[str, str], method: str, paths: int, lpips: Any) -> dict[str, Any]:
+    working = working_image(entry)
+    target = to_float_rgb(working)
+    fit = FitSettings.from_options(samvg.Config().fit, target)
+    started = time.perf_counter()
+    result = run_baseline(method, target, paths, fit, steps=BASELINE_STEPS)
+    seconds = time.perf_counter() - started
+    svg = result.to_svg()
+    height, width = target.shape[:2]
+    return {
+        "paths": svg.count("<path"),
+        "svg_bytes": len(svg.encode()),
+        "seconds": seconds,
+        **measured(render_svg(svg, width, height), target, lpips),
+    }
+
+
+def vtracer_record(entry: dict[str, str], setting: tuple[int, int, int], lpips: Any) -> dict:
+    working = working_image(entry)
+    target = to_float_rgb(working)
+    buffer = io.BytesIO()
+    Image.fromarray(working).save(buffer, format="PNG")
+    started = time.perf_counter()
+    svg = trace_once(buffer.getvalue(), *setting)
+    seconds = time.perf_counter() - started
+    height, width = target.shape[:2]
+    return {
+        "paths": svg.count("<path"),
+        "svg_bytes": len(svg.encode()),
+        "seconds": seconds,
+        **measured(render_svg(svg, width, height), target, lpips),
+    }
+
+
+def save(name: str, entry: dict[str, str], extra: dict[str, Any], make: Any, *args: Any) -> None:
+    """Run ``make(entry, *args)`` and keep its record, unless the record is there already."""
+    record_file = RECORDS / f"{entry['id']}.{name}.json"
+    if record_file.exists():
+        return
+    record = {"id": entry["id"], "category": entry["category"], **extra, **make(entry, *args)}
+    RECORDS.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(record_file, json.dumps(record, indent=1))
+    print(json.dumps(record), flush=True)
+
+
+def run_budget(entries: list[dict[str, str]], budgets: list[int], methods: list[str]) -> None:
+    lpips = load_lpips()
+    for budget in budgets:
+        for entry in entries:
+            for method in methods:
+                extra = {"study": "budget", "method": method, "budget": budget}
+                if method == "samvg":
+                    config = samvg.Config(paths=budget)
+                    save(f"samvg.{budget}", entry, extra, samvg_record, config, lpips)
+                else:
+                    save(f"{method}.{budget}", entry, extra, baseline_record, method, budget, lpips)
+
+
+def run_rate(entries: list[dict[str, str]], budgets: list[int]) -> None:
+    lpips = load_lpips()
+    for entry in entries:
+        for setting in VTRACER_SWEEP:
+            tag = "-".join(map(str, setting))
+            extra = {"study": "rate", "method": "vtracer", "setting": tag}
+            save(f"rate.vtracer.{tag}", entry, extra, vtracer_record, setting, lpips)
+        for budget in budgets:
+            extra = {"study": "rate", "method": "samvg", "setting": str(budget)}
+            config = samvg.Config(paths=budget)
+            save(f"rate.samvg.{budget}", entry, extra, samvg_record, config, lpips)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("study", choices=("budget", "rate", "report"))
+    parser.add_argument("--per-category", type=int, default=4)
+    parser.add_argument("--categories", help="comma-separated (default: all six)")
+    parser.add_argument("--paths", default="16,64", help="budgets, comma-separated")
+    parser.add_argument("--methods", default="samvg,vtracer,live,diffvg")
+    arguments = parser.parse_args()
+    if arguments.study == "report":
+        from detail_report import write_report
+
+        write_report(RECORDS, GEOMETRY)
+        return
+    categories = arguments.categories.split(",") if arguments.categories else None
+    if arguments.study == "rate" and categories is None:
+        categories = ["photo", "painting"]
+    entries = bench_entries(arguments.per_category, categories)
+    budgets = [int(text) for text in arguments.paths.split(",")]
+    if arguments.study == "budget":
+        run_budget(entries, budgets, arguments.methods.split(","))
+    else:
+        run_rate(entries, budgets)
+
+
+if __name__ == "__main__":
+    main()
