@@ -1,0 +1,187 @@
+"""The report of ``bench_detail.py``: the default against VTracer's default settings, samvg at
+fixed budgets against the baselines, and the rate-distortion plot for photos and paintings."""
+
+from __future__ import annotations
+
+import json
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from bench_images import REPO
+
+from samvg.io import atomic_write_text
+
+REPORT = REPO / "benchmarks/results/detail.md"
+PLOT = REPO / "benchmarks/results/detail_rate.png"
+FLAT_ART = ("emoji", "icon", "clipart", "digital_art")
+CATEGORIES = (*FLAT_ART, "photo", "painting")
+LPIPS_SLACK = 0.01
+BYTES_SHARE = 1 / 3
+
+
+def _records(folder: Path, pattern: str) -> list[dict[str, Any]]:
+    return [json.loads(path.read_text()) for path in sorted(folder.glob(pattern))]
+
+
+def _mean(rows: list[dict[str, Any]], key: str) -> float:
+    return float(np.mean([row[key] for row in rows]))
+
+
+def default_table(geometry: Path) -> list[str]:
+    """samvg's default against VTracer's default settings, per category."""
+    rows = [r for r in _records(geometry, "*.default.json") if "vtracer_mse" in r]
+    lines = [
+        f"## The default against VTracer's default settings ({len(rows)} of 75 images)",
+        "",
+        "Records from `python benchmarks/bench_geometry.py --settings default` (which also counts "
+        "the geometry of issue 12, see `geometry.md`). A *win* is MSE ≤ VTracer's, LPIPS ≤ "
+        f"VTracer's + {LPIPS_SLACK} and SVG bytes ≤ {BYTES_SHARE:.2f} × VTracer's (the issue's "
+        "goal: wins on ≥ 80 % of the emoji, icon, clipart and digital-art images).",
+        "",
+        "| category | images | samvg paths | VTracer paths | samvg bytes | VTracer bytes | "
+        "samvg MSE ×1e-3 | VTracer MSE ×1e-3 | samvg LPIPS | VTracer LPIPS | MSE ≤ | "
+        "LPIPS ≤ +0.01 | bytes ≤ 1/3 | wins | samvg s/image |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    groups: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for row in rows:
+        groups[row["category"]].append(row)
+        if row["category"] in FLAT_ART:
+            groups["flat art (4 categories)"].append(row)
+        groups["all"].append(row)
+    for name in (*CATEGORIES, "flat art (4 categories)", "all"):
+        group = groups.get(name)
+        if not group:
+            continue
+        mse = sum(r["mse"] <= r["vtracer_mse"] for r in group)
+        lpips = sum(r["lpips"] <= r["vtracer_lpips"] + LPIPS_SLACK for r in group)
+        small = sum(r["svg_bytes"] <= BYTES_SHARE * r["vtracer_bytes"] for r in group)
+        wins = sum(
+            r["mse"] <= r["vtracer_mse"]
+            and r["lpips"] <= r["vtracer_lpips"] + LPIPS_SLACK
+            and r["svg_bytes"] <= BYTES_SHARE * r["vtracer_bytes"]
+            for r in group
+        )
+        count = len(group)
+        lines.append(
+            f"| {name} | {count} | {_mean(group, 'paths'):.1f} | "
+            f"{_mean(group, 'vtracer_paths'):.1f} | {_mean(group, 'svg_bytes'):.0f} | "
+            f"{_mean(group, 'vtracer_bytes'):.0f} | {1e3 * _mean(group, 'mse'):.2f} | "
+            f"{1e3 * _mean(group, 'vtracer_mse'):.2f} | {_mean(group, 'lpips'):.3f} | "
+            f"{_mean(group, 'vtracer_lpips'):.3f} | {mse}/{count} | {lpips}/{count} | "
+            f"{small}/{count} | **{wins}/{count}** ({wins / count:.0%}) | "
+            f"{_mean(group, 'seconds'):.1f} |"
+        )
+    return lines
+
+
+def budget_tables(records: list[dict[str, Any]]) -> list[str]:
+    """Per budget and category: each method's means, and samvg's wins against each baseline
+    (lower MSE and lower LPIPS on the same image)."""
+    rows = [r for r in records if r.get("study") == "budget"]
+    by_key: dict[tuple[int, str], dict[str, dict[str, Any]]] = defaultdict(dict)
+    for row in rows:
+        by_key[(row["budget"], row["id"])][row["method"]] = row
+    lines = [
+        "## Equal budgets",
+        "",
+        "`python benchmarks/bench_detail.py budget --per-category 4 --paths 16,64`: samvg with "
+        "`--paths N`; VTracer with its settings searched for the path count closest to N "
+        "(`samvg.baselines.vtracer_trace`); the LIVE-style baseline and random init (diffvg) "
+        f"fitted with samvg's losses for {2 * 500} steps. Means over the images with every "
+        "method; *wins* = images where samvg has lower MSE **and** lower LPIPS than that "
+        "method (the goal: ≥ 90 % in every category).",
+    ]
+    for budget in sorted({b for b, _ in by_key}):
+        complete = {i: m for (b, i), m in by_key.items() if b == budget and "samvg" in m}
+        methods = sorted({name for m in complete.values() for name in m} - {"samvg"})
+        lines += [
+            "",
+            f"### N = {budget}",
+            "",
+            "| category | images | method | paths | MSE ×1e-3 | LPIPS | bytes | s | samvg wins |",
+            "|---|---:|---|---:|---:|---:|---:|---:|---:|",
+        ]
+        by_category: dict[str, list[dict[str, dict[str, Any]]]] = defaultdict(list)
+        for found in complete.values():
+            by_category[found["samvg"]["category"]].append(found)
+        for category in CATEGORIES:
+            images = [m for m in by_category.get(category, []) if set(methods) <= set(m)]
+            for method in ["samvg", *methods]:
+                if not images:
+                    continue
+                group = [m[method] for m in images]
+                wins = ""
+                if method != "samvg":
+                    won = sum(
+                        m["samvg"]["mse"] < m[method]["mse"]
+                        and m["samvg"]["lpips"] < m[method]["lpips"]
+                        for m in images
+                    )
+                    wins = f"{won}/{len(images)}"
+                lines.append(
+                    f"| {category} | {len(images)} | {method} | {_mean(group, 'paths'):.1f} | "
+                    f"{1e3 * _mean(group, 'mse'):.2f} | {_mean(group, 'lpips'):.3f} | "
+                    f"{_mean(group, 'svg_bytes'):.0f} | {_mean(group, 'seconds'):.1f} | {wins} |"
+                )
+    return lines
+
+
+def rate_plot(records: list[dict[str, Any]]) -> list[str]:
+    """Mean MSE and LPIPS against mean SVG bytes for photos and paintings, per setting."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = [r for r in records if r.get("study") == "rate"]
+    if not rows:
+        return []
+    curves: dict[str, dict[str, list[dict[str, Any]]]] = defaultdict(lambda: defaultdict(list))
+    for row in rows:
+        curves[row["method"]][row["setting"]].append(row)
+    figure, axes = plt.subplots(1, 2, figsize=(10, 4))
+    lines = ["", "## Rate-distortion, photos and paintings", "", f"![rate]({PLOT.name})", ""]
+    lines += [
+        "| method | setting | images | bytes | MSE ×1e-3 | LPIPS |",
+        "|---|---|---:|---:|---:|---:|",
+    ]
+    for method, settings in sorted(curves.items()):
+        points = sorted(
+            (_mean(g, "svg_bytes"), _mean(g, "mse"), _mean(g, "lpips"), s, len(g))
+            for s, g in settings.items()
+        )
+        for size, mse, lpips, setting, count in points:
+            lines.append(
+                f"| {method} | {setting} | {count} | {size:.0f} | {1e3 * mse:.2f} | {lpips:.3f} |"
+            )
+        sizes = [p[0] for p in points]
+        axes[0].plot(sizes, [p[1] for p in points], "o-", label=method)
+        axes[1].plot(sizes, [p[2] for p in points], "o-", label=method)
+    for axis, name in zip(axes, ("MSE", "LPIPS"), strict=True):
+        axis.set_xscale("log")
+        axis.set_xlabel("SVG bytes (mean)")
+        axis.set_ylabel(name)
+        axis.legend()
+    figure.tight_layout()
+    figure.savefig(PLOT, dpi=100)
+    return lines
+
+
+def write_report(records_folder: Path, geometry: Path) -> None:
+    records = _records(records_folder, "*.json")
+    lines = [
+        "# Detail at any path budget (issue 11)",
+        "",
+        "All images at 512 px on this machine (2 cores, shared); MSE and LPIPS (AlexNet) at the "
+        "working size; SVG bytes as written.",
+        "",
+        *default_table(geometry),
+        "",
+        *budget_tables(records),
+        *rate_plot(records),
+    ]
+    atomic_write_text(REPORT, "\n".join(lines) + "\n")
+    print(f"wrote {REPORT}")
