@@ -205,10 +205,15 @@ def main() -> None:
     parser.add_argument("--settings", default="default,fixed5")
     parser.add_argument("--report", type=Path, default=REPO / "benchmarks/results/geometry.md")
     parser.add_argument("--report-only", action="store_true")
+    parser.add_argument(
+        "--shard", default="0/1", help="i/n: run only every n-th image from the i-th (workers)"
+    )
     arguments = parser.parse_args()
     names = arguments.settings.split(",")
+    shard, shards = (int(part) for part in arguments.shard.split("/"))
     if not arguments.report_only:
-        run_all(bench_entries(arguments.per_category), arguments.out, names)
+        entries = bench_entries(arguments.per_category)[shard::shards]
+        run_all(entries, arguments.out, names)
     write_report(arguments.out, names, arguments.report)
 
 

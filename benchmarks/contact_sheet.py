@@ -1,7 +1,8 @@
-"""Contact sheet for the visual check: target | samvg | VTracer (default settings), one row per
-bench image, with path counts, MSE and SVG bytes under each picture.
+"""Contact sheet for the visual check: target | samvg | VTracer (default settings) [| samvg at
+N paths], one row per bench image, with path counts, MSE and SVG bytes under each picture.
 
     python benchmarks/contact_sheet.py --per-category 2 --preset fast --output sheet.png
+    python benchmarks/contact_sheet.py --per-category 2 --preset default --budget 64 --output s.png
 
 Photos and paintings may be drawn for a local look (``--categories photo,painting``), but their
 sheets must not be committed (the bench's licences forbid copies of them in the repository).
@@ -35,7 +36,9 @@ def cell(picture: np.ndarray, caption: str) -> Image.Image:
     return canvas
 
 
-def row_for(entry: dict[str, str], config: samvg.Config) -> list[Image.Image]:
+def row_for(
+    entry: dict[str, str], config: samvg.Config, budget: int | None = None
+) -> list[Image.Image]:
     run = run_samvg(entry, config)
     target, result = run.target, run.result
     ours = run.render()
@@ -54,11 +57,18 @@ def row_for(entry: dict[str, str], config: samvg.Config) -> list[Image.Image]:
         f"{len(svg)} B",
         flush=True,
     )
-    return [
+    row = [
         cell(target, f"{entry['id'][:36]}"),
         cell(ours, f"samvg {paths}p {mse(ours) * 1e3:.1f}e-3 {ours_bytes / 1e3:.1f}kB"),
         cell(theirs, f"vtracer {paths_theirs}p {mse(theirs) * 1e3:.1f}e-3 {len(svg) / 1e3:.0f}kB"),
     ]
+    if budget is not None:
+        fixed = run_samvg(entry, config.replace(paths=budget))
+        picture, count = fixed.render(), fixed.result.counts.get("paths", 0)
+        size = len(fixed.result.image.to_svg().encode())
+        row.append(cell(picture, f"samvg --paths {budget}: {count}p {mse(picture) * 1e3:.1f}e-3 "
+                                 f"{size / 1e3:.1f}kB"))  # fmt: skip
+    return row
 
 
 def main() -> None:
@@ -67,13 +77,15 @@ def main() -> None:
     parser.add_argument("--categories", default="emoji,icon,clipart,digital_art")
     parser.add_argument("--preset", choices=sorted(PRESETS), default="fast")
     parser.add_argument("--output", type=Path, required=True)
+    parser.add_argument("--budget", type=int, help="add a column: samvg with --paths N")
     arguments = parser.parse_args()
     wanted = arguments.categories.split(",")
     if arguments.output.resolve().is_relative_to(REPO) and {"photo", "painting"} & set(wanted):
         sys.exit("photo and painting sheets stay out of the repository: write them elsewhere")
     config = PRESETS[arguments.preset]()
-    rows = [row_for(entry, config) for entry in bench_entries(arguments.per_category, wanted)]
-    sheet = Image.new("RGB", (3 * CELL, len(rows) * (CELL + CAPTION)), "white")
+    entries = bench_entries(arguments.per_category, wanted)
+    rows = [row_for(entry, config, arguments.budget) for entry in entries]
+    sheet = Image.new("RGB", (len(rows[0]) * CELL, len(rows) * (CELL + CAPTION)), "white")
     for index, row in enumerate(rows):
         for column, picture in enumerate(row):
             sheet.paste(picture, (column * CELL, index * (CELL + CAPTION)))
