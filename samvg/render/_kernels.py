@@ -49,6 +49,8 @@ import math
 import numpy as np
 from numba import njit
 
+from samvg.render._paint_kernels import FLAT, paint_backward, paint_colour
+
 _MAX_PIECES = 256
 _EPS_ACC = 1e-9
 
@@ -317,9 +319,12 @@ def _path_deposits(
 def render_forward(
     verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray, off: np.ndarray,
     colors: np.ndarray, background: np.ndarray, canvas: np.ndarray, acc: np.ndarray,
-    under: np.ndarray, keep: bool,
+    under: np.ndarray, keep: bool, kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
 ) -> None:  # fmt: skip
     """Coverage and straight-alpha "over" compositing, path by path in paint order.
+
+    A path whose ``kinds`` entry is not ``FLAT`` takes its RGB per pixel from its gradient paint
+    (``samvg.render._paint_kernels``); its alpha is still ``colors[p, 3]``.
 
     ``canvas`` (H, W, 3, float32 or float64) receives the image. With ``keep`` the winding-area
     of every box pixel stays in ``acc`` at ``off[p]`` and the colour under it in ``under`` (for the
@@ -345,6 +350,7 @@ def render_forward(
         cr = colors[p, 0]
         cg = colors[p, 1]
         cb = colors[p, 2]
+        flat = kinds[p] == FLAT
         stride = bw + 1
         for r in range(bh):
             y = by0 + r
@@ -361,6 +367,8 @@ def render_forward(
                     under[k, 2] = canvas[y, x, 2]
                 cov = min(1.0, abs(wind))
                 if cov > 0.0:
+                    if not flat:
+                        cr, cg, cb = paint_colour(kinds, stops, params, p, x + 0.5, y + 0.5)
                     ac = a * cov
                     keep_c = 1.0 - ac
                     canvas[y, x, 0] = canvas[y, x, 0] * keep_c + cr * ac
@@ -555,8 +563,10 @@ def _edge_backward(
 def render_backward(
     grad_out: np.ndarray, verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray,
     off: np.ndarray, colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """Gradients of ``render_forward``: (dL/d vertex (V, 2), dL/d colour (P, 4)).
+    kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """Gradients of ``render_forward``: (dL/d vertex (V, 2), dL/d colour (P, 4), dL/d gradient
+    paint parameters (P, PARAMS); a gradient path's RGB gradient goes to the last).
 
     Paths are visited in reverse paint order. For each: dL/dcov of its box pixels goes to the
     scratch ``dcov`` (size of the largest box), colour gradients are summed, the running canvas
@@ -566,6 +576,7 @@ def render_backward(
     n_paths = box.shape[0]
     gverts = np.zeros(verts.shape, np.float64)
     gcol = np.zeros((n_paths, 4), np.float64)
+    gparams = np.zeros(params.shape, np.float64)
     for p in range(n_paths - 1, -1, -1):
         bw = box[p, 2]
         bh = box[p, 3]
@@ -577,6 +588,7 @@ def render_backward(
         cr = colors[p, 0]
         cg = colors[p, 1]
         cb = colors[p, 2]
+        flat = kinds[p] == FLAT
         stride = bw + 1
         o = off[p]
         sr = 0.0
@@ -591,14 +603,22 @@ def render_backward(
                 g0 = grad_out[y, x, 0]
                 g1 = grad_out[y, x, 1]
                 g2 = grad_out[y, x, 2]
+                if not flat:
+                    cr, cg, cb = paint_colour(kinds, stops, params, p, x + 0.5, y + 0.5)
                 dot = g0 * (cr - under[k, 0]) + g1 * (cg - under[k, 1]) + g2 * (cb - under[k, 2])
                 dcov[r * stride + c] = a * dot
                 cov = min(1.0, abs(acc[k]))
                 if cov > 0.0:
                     ac = a * cov
-                    sr += g0 * ac
-                    sg += g1 * ac
-                    sb += g2 * ac
+                    if flat:
+                        sr += g0 * ac
+                        sg += g1 * ac
+                        sb += g2 * ac
+                    else:
+                        paint_backward(
+                            kinds, stops, params, p, x + 0.5, y + 0.5,
+                            g0 * ac, g1 * ac, g2 * ac, gparams,
+                        )  # fmt: skip
                     sa += cov * dot
                     keep = 1.0 - ac
                     grad_out[y, x, 0] = g0 * keep
@@ -630,4 +650,4 @@ def render_backward(
             gverts[i, 1] += gya
             gverts[j, 0] += gxb
             gverts[j, 1] += gyb
-    return gverts, gcol
+    return gverts, gcol, gparams

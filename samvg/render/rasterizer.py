@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -17,6 +18,7 @@ import torch
 
 from samvg.errors import InputError
 from samvg.render import _kernels as K
+from samvg.render._paint_kernels import FLAT, LINEAR, MAX_STOPS, PARAMS, RADIAL
 from samvg.scene import Scene
 
 #: Maximum chord error (pixels) of the polyline that replaces each cubic segment.
@@ -122,12 +124,46 @@ def _report_nonfinite(arr: np.ndarray, starts: np.ndarray, what: str) -> None:
         raise InputError(f"path {path} has non-finite {what}")
 
 
+@dataclass(frozen=True)
+class GradientPaints:
+    """Per path: the paint kind (``FLAT``, ``LINEAR``, ``RADIAL``), the stop count (2 to
+    ``MAX_STOPS``) and the parameters (P, ``PARAMS``): geometry, stop offsets, stop RGB (see
+    ``samvg.render._paint_kernels``). Flat paths ignore their row."""
+
+    kinds: np.ndarray
+    stops: np.ndarray
+    params: torch.Tensor
+
+    @classmethod
+    def flat(cls, count: int) -> GradientPaints:
+        return cls(
+            np.zeros(count, np.int64), np.zeros(count, np.int64), torch.zeros((count, PARAMS))
+        )
+
+    def check(self, count: int) -> None:
+        kinds, stops = self.kinds, self.stops
+        if kinds.shape != (count,) or stops.shape != (count,):
+            raise InputError(f"gradient paints must describe {count} paths")
+        if tuple(self.params.shape) != (count, PARAMS):
+            raise InputError(f"gradient parameters must have shape ({count}, {PARAMS})")
+        if not np.isin(kinds, (FLAT, LINEAR, RADIAL)).all():
+            raise InputError("paint kinds must be flat (0), linear (1) or radial (2)")
+        shaded = kinds != FLAT
+        if np.any((stops[shaded] < 2) | (stops[shaded] > MAX_STOPS)):
+            raise InputError(f"a gradient needs 2 to {MAX_STOPS} stops")
+        if count and not torch.isfinite(self.params.detach()).all():
+            raise InputError("gradient parameters must be finite")
+
+
 class _Rasterize(torch.autograd.Function):
     @staticmethod
     def forward(
         ctx: Any,
         flat_pts: torch.Tensor,
         colors: torch.Tensor,
+        params: torch.Tensor,
+        kinds: np.ndarray,
+        stops: np.ndarray,
         starts: np.ndarray,
         width: int,
         height: int,
@@ -142,10 +178,11 @@ class _Rasterize(torch.autograd.Function):
         if clipped.any():
             pts = np.clip(pts, -_FAR, _FAR)
         cols = np.ascontiguousarray(colors.detach().cpu().numpy(), dtype=np.float64)
+        paint = np.ascontiguousarray(params.detach().cpu().numpy(), dtype=np.float64)
         seg_n, vstart, verts = K.plan_and_flatten(pts, starts, width, height, tol)
         box, off = K.path_boxes(verts, vstart, width, height)
         # needs_input_grad ignores torch.no_grad(); keep backward state only if it can be used.
-        keep = grad_enabled and (ctx.needs_input_grad[0] or ctx.needs_input_grad[1])
+        keep = grad_enabled and any(ctx.needs_input_grad[:3])
         n_cells = int(off[-1])
         largest = int(np.max(np.diff(off))) if len(off) > 1 else 0
         out_dtype = np.float64 if flat_pts.dtype == torch.float64 else np.float32
@@ -158,10 +195,14 @@ class _Rasterize(torch.autograd.Function):
                 f"scene too large to rasterize: {n_cells} path-box pixels on a "
                 f"{width}x{height} canvas"
             ) from exc
-        K.render_forward(verts, vstart, box, off, cols, bg, canvas, acc, under, keep)
+        K.render_forward(
+            verts, vstart, box, off, cols, bg, canvas, acc, under, keep, kinds, stops, paint
+        )
         ctx.col_dtype = colors.dtype
+        ctx.paint_dtype = params.dtype
         if keep:
             ctx.state = (pts.shape[0], starts, seg_n, vstart, verts, box, off, acc, under, cols)
+            ctx.paints = (kinds, stops, paint)
             ctx.clipped = clipped if clipped.any() else None
             ctx.largest = largest
         return torch.from_numpy(canvas).to(dtype=flat_pts.dtype, device=flat_pts.device)
@@ -172,8 +213,10 @@ class _Rasterize(torch.autograd.Function):
         n_ctrl, starts, seg_n, vstart, verts, box, off, acc, under, cols = ctx.state
         go = np.array(grad_out.detach().cpu().numpy(), dtype=np.float64, order="C", copy=True)
         dcov = np.empty(ctx.largest, np.float64)
-        gverts, gcol = K.render_backward(go, verts, vstart, box, off, cols, acc, under, dcov)
-        g_pts = g_col = None
+        gverts, gcol, gpaint = K.render_backward(
+            go, verts, vstart, box, off, cols, acc, under, dcov, *ctx.paints
+        )
+        g_pts = g_col = g_paint = None
         if ctx.needs_input_grad[0]:
             g = K.flatten_backward(gverts, starts, seg_n, vstart, n_ctrl)
             if ctx.clipped is not None:
@@ -181,7 +224,9 @@ class _Rasterize(torch.autograd.Function):
             g_pts = torch.from_numpy(g).to(dtype=grad_out.dtype, device=grad_out.device)
         if ctx.needs_input_grad[1]:
             g_col = torch.from_numpy(gcol).to(dtype=ctx.col_dtype, device=grad_out.device)
-        return g_pts, g_col, None, None, None, None, None, None
+        if ctx.needs_input_grad[2]:
+            g_paint = torch.from_numpy(gpaint).to(dtype=ctx.paint_dtype, device=grad_out.device)
+        return g_pts, g_col, g_paint, *([None] * 8)
 
 
 def rasterize(
@@ -193,6 +238,7 @@ def rasterize(
     *,
     offsets: np.ndarray | None = None,
     tolerance: float = FLATTEN_TOLERANCE,
+    gradients: GradientPaints | None = None,
 ) -> torch.Tensor:
     """Render closed cubic Bézier paths with exact box-filtered coverage, differentiably.
 
@@ -206,11 +252,14 @@ def rasterize(
         width, height: canvas size in pixels.
         background: opaque RGB behind the paths; ``None`` means white.
         tolerance: maximum chord error (pixels) when flattening the cubics.
+        gradients: linear and radial gradient paints (`GradientPaints`); a path whose kind is
+            not flat takes its RGB from them (its alpha stays ``colors[p, 3]``).
 
     Returns:
         ``(height, width, 3)`` tensor, float64 for float64 ``points``, float32 otherwise,
         paths composited with straight-alpha "over" in paint order, nonzero fill rule.
-        Differentiable w.r.t. ``points`` and ``colors`` (analytic boundary gradients).
+        Differentiable w.r.t. ``points``, ``colors`` and the gradient parameters (analytic
+        boundary gradients).
 
     Raises:
         InputError (a ValueError): bad shapes, non-finite coordinates/colours (naming the path),
@@ -238,9 +287,21 @@ def rasterize(
         if col_np.size and not np.isfinite(col_np).all():
             bad = int(np.flatnonzero(~np.isfinite(col_np).all(axis=1))[0])
             raise InputError(f"path {bad} has a non-finite colour")
+    paints = gradients if gradients is not None else GradientPaints.flat(n_paths)
+    paints.check(n_paths)
     try:
         return _Rasterize.apply(
-            flat, cols, starts, width, height, bg, float(tolerance), torch.is_grad_enabled()
+            flat,
+            cols,
+            paints.params,
+            paints.kinds,
+            paints.stops,
+            starts,
+            width,
+            height,
+            bg,
+            float(tolerance),
+            torch.is_grad_enabled(),
         )
     except MemoryError as exc:
         raise InputError(f"canvas {width}x{height} is too large to allocate") from exc
