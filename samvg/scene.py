@@ -10,8 +10,9 @@ each path starts. A path with K segments owns 3K points; segment k runs from ``p
 ``p[3k+1]`` and ``p[3k+2]`` to ``p[(3k+3) % 3K]``, so the last segment returns to the first
 point. Pixel (row r, column c) is the square [c, c+1] × [r, r+1].
 
-Paints are immutable values, one per path. Only flat RGBA fills exist today; gradient paints
-will join :data:`Paint` without changing the packing of the geometry.
+Paints are immutable values, one per path: a flat RGBA fill, or a linear or radial gradient
+(2 to 4 stops, geometry in the scene's pixels, one opacity for the whole fill). Every paint has
+``rgba``, a flat stand-in (its mean stop colour) for the steps that compare fills by colour.
 """
 
 from __future__ import annotations
@@ -50,9 +51,111 @@ class FlatPaint:
     def opaque(self) -> bool:
         return self.rgba[3] >= 1.0
 
+    def scaled(self, _factor: float) -> FlatPaint:
+        """The paint on a canvas scaled by ``factor`` (a flat fill has no geometry)."""
+        return self
 
-Paint = FlatPaint
-"""Every paint a path can have (linear and radial gradients will join this union)."""
+
+Stop = tuple[float, RGB]
+"""A gradient stop: offset in [0, 1] and RGB in [0, 1]."""
+MAX_STOPS = 4
+
+
+def _check_stops(stops: Sequence[tuple[float, Sequence[float]]]) -> tuple[Stop, ...]:
+    checked: list[Stop] = []
+    for offset, rgb in stops:
+        colour = tuple(float(value) for value in rgb)
+        if len(colour) != 3 or not all(math.isfinite(v) and 0.0 <= v <= 1.0 for v in colour):
+            raise InputError(f"gradient stop colours must be RGB values in [0, 1], got {rgb}")
+        checked.append((float(offset), (colour[0], colour[1], colour[2])))
+    offsets = [offset for offset, _ in checked]
+    if not 2 <= len(checked) <= MAX_STOPS:
+        raise InputError(f"a gradient needs 2 to {MAX_STOPS} stops, got {len(checked)}")
+    if not all(math.isfinite(o) and 0.0 <= o <= 1.0 for o in offsets) or offsets != sorted(offsets):
+        raise InputError(f"gradient stop offsets must rise within [0, 1], got {offsets}")
+    return tuple(checked)
+
+
+def _check_opacity(opacity: float) -> float:
+    value = float(opacity)
+    if not (math.isfinite(value) and 0.0 <= value <= 1.0):
+        raise InputError(f"fill opacity must be in [0, 1], got {opacity}")
+    return value
+
+
+def _check_point(point: Sequence[float], name: str) -> tuple[float, float]:
+    values = tuple(float(v) for v in point)
+    if len(values) != 2 or not all(math.isfinite(v) for v in values):
+        raise InputError(f"gradient {name} must be two finite numbers, got {point}")
+    return (values[0], values[1])
+
+
+@dataclass(frozen=True)
+class _Gradient:
+    stops: tuple[Stop, ...]
+    opacity: float = 1.0
+
+    @property
+    def rgba(self) -> RGBA:
+        """The mean of the stop colours, with the opacity: a flat stand-in for this paint."""
+        mean = np.mean([rgb for _, rgb in self.stops], axis=0)
+        return (float(mean[0]), float(mean[1]), float(mean[2]), self.opacity)
+
+    @property
+    def opaque(self) -> bool:
+        return self.opacity >= 1.0
+
+    @property
+    def parameter_count(self) -> int:
+        """Geometry, then an offset and RGB per stop, and the opacity."""
+        return 4 * len(self.stops) + 1 + self.geometry_count
+
+    geometry_count = 4
+
+
+@dataclass(frozen=True)
+class LinearGradient(_Gradient):
+    """Colours along the vector ``start`` → ``end`` (SVG ``linearGradient``, userSpaceOnUse,
+    pad)."""
+
+    start: tuple[float, float] = (0.0, 0.0)
+    end: tuple[float, float] = (1.0, 0.0)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "stops", _check_stops(self.stops))
+        object.__setattr__(self, "opacity", _check_opacity(self.opacity))
+        object.__setattr__(self, "start", _check_point(self.start, "start"))
+        object.__setattr__(self, "end", _check_point(self.end, "end"))
+
+    def scaled(self, factor: float) -> LinearGradient:
+        start = (self.start[0] * factor, self.start[1] * factor)
+        return replace(self, start=start, end=(self.end[0] * factor, self.end[1] * factor))
+
+
+@dataclass(frozen=True)
+class RadialGradient(_Gradient):
+    """Colours by distance from ``centre`` over ``radius`` (SVG ``radialGradient``, focal point
+    at the centre, userSpaceOnUse, pad)."""
+
+    centre: tuple[float, float] = (0.0, 0.0)
+    radius: float = 1.0
+    geometry_count = 3
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "stops", _check_stops(self.stops))
+        object.__setattr__(self, "opacity", _check_opacity(self.opacity))
+        object.__setattr__(self, "centre", _check_point(self.centre, "centre"))
+        if not (math.isfinite(self.radius) and self.radius > 0):
+            raise InputError(f"gradient radius must be a positive number, got {self.radius}")
+        object.__setattr__(self, "radius", float(self.radius))
+
+    def scaled(self, factor: float) -> RadialGradient:
+        centre = (self.centre[0] * factor, self.centre[1] * factor)
+        return replace(self, centre=centre, radius=self.radius * factor)
+
+
+Paint = FlatPaint | LinearGradient | RadialGradient
+"""Every paint a path can have."""
 
 
 @dataclass(frozen=True)
@@ -178,8 +281,13 @@ class Scene:
         for index, paint in enumerate(self.paints):
             yield self.path_points(index), paint
 
+    @property
+    def has_gradients(self) -> bool:
+        return any(not isinstance(paint, FlatPaint) for paint in self.paints)
+
     def colours(self) -> np.ndarray:
-        """Flat RGBA of every path, (P, 4) float64 (what the rasterizer draws)."""
+        """RGBA of every path, (P, 4) float64: the flat fill, or a gradient's flat stand-in
+        (the rasterizer takes a gradient's RGB from its stops and its alpha from here)."""
         if not self.paints:
             return np.zeros((0, 4))
         return np.array([paint.rgba for paint in self.paints], dtype=np.float64)
@@ -236,7 +344,7 @@ class Scene:
             self.frame.height,
             self.points / self.frame.scale,
             self.offsets,
-            self.paints,
+            tuple(paint.scaled(1.0 / self.frame.scale) for paint in self.paints),
             self.background,
             None,
         )

@@ -19,7 +19,7 @@ import torch
 from samvg.errors import InputError
 from samvg.render import _kernels as K
 from samvg.render._paint_kernels import FLAT, LINEAR, MAX_STOPS, PARAMS, RADIAL
-from samvg.scene import Scene
+from samvg.scene import FlatPaint, LinearGradient, Paint, Scene
 
 #: Maximum chord error (pixels) of the polyline that replaces each cubic segment.
 FLATTEN_TOLERANCE = 0.05
@@ -133,6 +133,29 @@ class GradientPaints:
     kinds: np.ndarray
     stops: np.ndarray
     params: torch.Tensor
+
+    @classmethod
+    def of(cls, paints: Sequence[Paint], scale: float = 1.0) -> GradientPaints:
+        """The gradient paints among ``paints`` (flat ones get empty rows), geometry × ``scale``."""
+        kinds = np.zeros(len(paints), np.int64)
+        stops = np.zeros(len(paints), np.int64)
+        params = np.zeros((len(paints), PARAMS))
+        for index, paint in enumerate(paints):
+            if isinstance(paint, FlatPaint):
+                continue
+            if isinstance(paint, LinearGradient):
+                kinds[index] = LINEAR
+                params[index, :4] = (*paint.start, *paint.end)
+                params[index, :4] *= scale
+            else:
+                kinds[index] = RADIAL
+                params[index, :3] = (*paint.centre, paint.radius)
+                params[index, :3] *= scale
+            stops[index] = len(paint.stops)
+            for number, (offset, rgb) in enumerate(paint.stops):
+                params[index, 4 + number] = offset
+                params[index, 8 + 3 * number : 11 + 3 * number] = rgb
+        return cls(kinds, stops, torch.from_numpy(params))
 
     @classmethod
     def flat(cls, count: int) -> GradientPaints:
@@ -314,6 +337,7 @@ def render_array(
     height: int,
     background: Sequence[float] | None = (1.0, 1.0, 1.0),
     offsets: np.ndarray | None = None,
+    gradients: GradientPaints | None = None,
 ) -> np.ndarray:
     """`rasterize` for numpy scenes, without gradients: points (P, 3K, 2), or packed (N, 2) with
     ``offsets``, and RGBA (P, 4) to a float32 (height, width, 3) array."""
@@ -325,6 +349,7 @@ def render_array(
             height,
             background=background,
             offsets=offsets,
+            gradients=gradients,
         )
     return image.numpy().astype(np.float32, copy=False)
 
@@ -343,6 +368,7 @@ def render_scene(scene: Scene, scale: float = 1.0) -> np.ndarray:
         height,
         background=scene.background_or_white,
         offsets=scene.offsets,
+        gradients=GradientPaints.of(scene.paints, scale) if scene.has_gradients else None,
     )
 
 

@@ -1,5 +1,7 @@
 """SVG text of a `Scene`: width, height and viewBox, an optional background rectangle, and one
-``<path>`` of absolute cubic commands per path, coordinates rounded to a fixed precision.
+``<path>`` of absolute cubic commands per path, coordinates rounded to a fixed precision. A
+gradient fill is a ``<linearGradient>`` or ``<radialGradient>`` (userSpaceOnUse) in ``<defs>``,
+one id per path (``g<path number>``), referenced by ``fill="url(#…)"``.
 
 Written by hand: the output is a dozen lines of fixed shape, and its bytes must not depend on
 a library's formatting choices (tests compare them).
@@ -12,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from samvg.errors import InputError
-from samvg.scene import Scene
+from samvg.scene import FlatPaint, LinearGradient, Paint, Scene
 
 SVG_NAMESPACE = "http://www.w3.org/2000/svg"
 MAX_PRECISION = 10
@@ -74,12 +76,46 @@ def scene_to_svg(scene: Scene, precision: int = 2) -> str:
             f'<rect width="{scene.width}" height="{scene.height}" '
             f'fill="{hex_colour(scene.background)}"/>'
         )
-    for points, paint in scene.paths():
+    definitions = [
+        gradient_element(paint, f"g{index}", precision)
+        for index, paint in enumerate(scene.paints)
+        if not isinstance(paint, FlatPaint)
+    ]
+    if definitions:
+        lines += ["<defs>", *definitions, "</defs>"]
+    for index, (points, paint) in enumerate(scene.paths()):
         opacity = paint.rgba[3]
         opacity_attribute = "" if opacity >= 1.0 else f' fill-opacity="{number(opacity, 3)}"'
-        lines.append(
-            f'<path d="{path_data(points, precision)}" '
-            f'fill="{hex_colour(paint.rgba[:3])}"{opacity_attribute}/>'
-        )
+        fill = hex_colour(paint.rgba[:3]) if isinstance(paint, FlatPaint) else f"url(#g{index})"
+        lines.append(f'<path d="{path_data(points, precision)}" fill="{fill}"{opacity_attribute}/>')
     lines.append("</svg>")
     return "\n".join(lines) + "\n"
+
+
+def gradient_element(paint: Paint, identifier: str, precision: int) -> str:
+    """The ``<linearGradient>`` or ``<radialGradient>`` element of a gradient paint."""
+    if isinstance(paint, FlatPaint):
+        raise InputError("a flat fill has no gradient element")
+    stops = "".join(
+        f'<stop offset="{number(offset, 4)}" stop-color="{hex_colour(rgb)}"/>'
+        for offset, rgb in paint.stops
+    )
+    if isinstance(paint, LinearGradient):
+        (x1, y1), (x2, y2) = paint.start, paint.end
+        geometry = " ".join(
+            f'{name}="{number(value, precision)}"'
+            for name, value in (("x1", x1), ("y1", y1), ("x2", x2), ("y2", y2))
+        )
+        return (
+            f'<linearGradient id="{identifier}" gradientUnits="userSpaceOnUse" {geometry}>'
+            f"{stops}</linearGradient>"
+        )
+    (cx, cy), radius = paint.centre, paint.radius
+    geometry = " ".join(
+        f'{name}="{number(value, precision)}"'
+        for name, value in (("cx", cx), ("cy", cy), ("r", radius))
+    )
+    return (
+        f'<radialGradient id="{identifier}" gradientUnits="userSpaceOnUse" {geometry}>'
+        f"{stops}</radialGradient>"
+    )

@@ -9,6 +9,8 @@ from samvg.errors import InputError
 from samvg.render import rasterize
 from samvg.render._paint_kernels import FLAT, LINEAR, PARAMS, RADIAL
 from samvg.render.rasterizer import GradientPaints
+from samvg.scene import FlatPaint, LinearGradient, RadialGradient, Scene
+from samvg.svg.writer import scene_to_svg
 
 SIZE = 24
 
@@ -124,3 +126,38 @@ def test_bad_gradient_paints_are_refused():
     bad[1, 0] = float("nan")
     with pytest.raises(InputError, match="finite"):
         rasterize(points, colours, 8, 8, gradients=GradientPaints(good.kinds, good.stops, bad))
+
+
+def random_gradient_scene(seed: int) -> Scene:
+    """Overlapping blobs, some translucent and some partly off the canvas, most with gradients."""
+    rng = np.random.default_rng(seed)
+    paths = []
+    for index in range(7):
+        centre = rng.uniform(-4, 52, 2)
+        points = blob(*centre, rng.uniform(6, 20))
+        stops = tuple(
+            (float(offset), tuple(rng.uniform(0, 1, 3)))
+            for offset in np.sort(rng.uniform(0, 1, rng.integers(2, 5)))
+        )
+        opacity = 1.0 if index % 3 else float(rng.uniform(0.4, 0.9))
+        if index % 3 == 2:
+            paint = FlatPaint((*rng.uniform(0, 1, 3), opacity))
+        elif index % 2:
+            start, end = rng.uniform(-10, 58, 2), rng.uniform(-10, 58, 2)
+            paint = LinearGradient(stops, opacity, tuple(start), tuple(end))
+        else:
+            paint = RadialGradient(stops, opacity, tuple(rng.uniform(0, 48, 2)), rng.uniform(5, 40))
+        paths.append((points, paint))
+    return Scene.from_paths(48, 48, paths, background=(0.95, 0.9, 0.85))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_our_render_of_a_gradient_scene_agrees_with_resvg_of_its_svg(seed):
+    from tests.render.render_reference import resvg_render
+
+    scene = random_gradient_scene(seed)
+    svg = scene_to_svg(scene, precision=4)
+    assert svg.count("Gradient id=") >= 4 and "url(#g" in svg
+    ours = scene.render()
+    theirs = resvg_render(svg)
+    assert np.abs(ours - theirs).mean() <= 1 / 255
