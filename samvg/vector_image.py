@@ -126,5 +126,10 @@ class VectorImage:
         ``<rect>`` drawn first becomes the background. Elements or attributes this model cannot
         represent raise :class:`InputError` naming them."""
         parsed = read_svg(text)
-        paths = [VectorPath(points, fill) for points, fill in parsed.paths]
-        return cls(parsed.width, parsed.height, paths, parsed.background)
+        paths = [
+            (points, FlatPaint(fill) if isinstance(fill, tuple) else fill)
+            for points, fill in parsed.paths
+        ]
+        return cls.from_scene(
+            Scene.from_paths(parsed.width, parsed.height, paths, parsed.background)
+        )

@@ -27,6 +27,8 @@ import numpy as np
 import svgelements
 
 from samvg.errors import InputError
+from samvg.scene import LinearGradient, RadialGradient
+from samvg.svg.gradients import gradient_paint
 
 __all__ = ["ParsedSvg", "read_svg"]
 
@@ -104,6 +106,8 @@ _TRANSFORM_COUNTS = {
 _HEX_COLOUR = re.compile(r"^#(?:[0-9a-fA-F]{3,4}|[0-9a-fA-F]{6}|[0-9a-fA-F]{8})$")
 
 _Rgba = tuple[float, float, float, float]
+_Fill = _Rgba | LinearGradient | RadialGradient
+_URL = re.compile(r"url\(\s*#([^)\s]+)\s*\)")
 
 
 @dataclass(frozen=True)
@@ -111,13 +115,14 @@ class ParsedSvg:
     """A canvas of ``width`` × ``height`` pixels, an optional opaque background and filled paths.
 
     ``paths`` holds ``(points, fill)`` pairs in paint order: ``points`` a float64 (3K, 2) array of
-    closed cubic control points in canvas pixels, ``fill`` straight RGBA in [0, 1].
+    closed cubic control points in canvas pixels, ``fill`` straight RGBA in [0, 1] or a gradient
+    paint in canvas pixels (see `samvg.svg.gradients`).
     """
 
     width: int
     height: int
     background: tuple[float, float, float] | None
-    paths: list[tuple[np.ndarray, tuple[float, float, float, float]]]
+    paths: list[tuple[np.ndarray, _Fill]]
 
 
 def read_svg(text: str) -> ParsedSvg:
@@ -129,10 +134,11 @@ def read_svg(text: str) -> ParsedSvg:
     root = _parse_xml(text)
     geometry = _Geometry.of(root)
     try:
-        _prepare(root, "svg", _ids(root))
+        ids = _ids(root)
+        _prepare(root, "svg", ids)
         _check_use_expansion(root)
         document = _parse_with_svgelements(root, geometry)
-        scene = _Scene(geometry)
+        scene = _Scene(geometry, ids)
         if document is not None:  # None: the root is not rendered (display:none), no shapes
             _read_group(document, scene, _opacity(document, 1.0, "svg"), use_label=None)
     except RecursionError:
@@ -423,8 +429,9 @@ def _parse_with_svgelements(root: ElementTree.Element, geometry: _Geometry) -> A
 @dataclass
 class _Scene:
     geometry: _Geometry
+    ids: dict[str, ElementTree.Element] = field(default_factory=dict)
     background: tuple[float, float, float] | None = None
-    paths: list[tuple[np.ndarray, _Rgba]] = field(default_factory=list)
+    paths: list[tuple[np.ndarray, _Fill]] = field(default_factory=list)
 
 
 def _label(element: Any, use_label: str | None) -> str:
@@ -483,7 +490,7 @@ def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
         raise InputError(f"{label}: <line> has no area (only filled shapes are supported)")
     if isinstance(shape, svgelements.Rect) and (shape.rx or shape.ry):
         raise InputError(f"{label}: rounded rectangles are not supported")
-    fill = _fill(values, opacity, label)
+    fill = _fill(values, opacity, label, scene, shape.transform)
     # Cubics in the shape's own coordinates, then its transform: svgelements' transformed arcs
     # are wrong under skews (it keeps ellipse axes orthogonal), while cubics map exactly.
     local = _cubic_points(shape.segments(transformed=False), label)
@@ -494,6 +501,7 @@ def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
         isinstance(shape, svgelements.Rect)
         and not scene.paths
         and scene.background is None
+        and isinstance(fill, tuple)
         and fill[3] >= 1.0
         and _covers_canvas(points, scene.geometry)
     ):
@@ -536,17 +544,43 @@ def _number(text: str, label: str) -> float:
     return value
 
 
-def _fill(values: dict[str, Any], opacity: float, label: str) -> _Rgba:
-    """The element's resolved fill (svgelements has applied CSS, ``style`` and inheritance)."""
+def _fill(
+    values: dict[str, Any], opacity: float, label: str, scene: _Scene, transform: Any
+) -> _Fill:
+    """The element's resolved fill (svgelements has applied CSS, ``style`` and inheritance): RGBA,
+    or a gradient paint in canvas pixels."""
     colour_text = str(values.get("fill", "black")).strip()
+    reference = _URL.fullmatch(colour_text)
+    if reference is not None:
+        target = scene.ids.get(reference.group(1))
+        if target is None or _local_name(target.tag) not in ("linearGradient", "radialGradient"):
+            raise InputError(f"{label}: fill={colour_text!r} names no gradient")
+        _check_fill_rule(values, label)
+        alpha = _number(values.get("fill-opacity", "1"), label) * opacity
+        alpha = min(max(alpha, 0.0), 1.0)
+        return gradient_paint(
+            target, _user_to_pixels(transform, scene.geometry), alpha, label, _colour
+        )
     if colour_text == "none" or colour_text.startswith("url("):
         raise InputError(f"{label}: fill={colour_text!r} is not supported (only solid fills)")
-    fill_rule = str(values.get("fill-rule", "nonzero")).strip()
-    if fill_rule != "nonzero":
-        raise InputError(f"{label}: fill-rule={fill_rule!r} is not supported")
+    _check_fill_rule(values, label)
     red, green, blue, alpha = _colour(colour_text, label)
     alpha *= _number(values.get("fill-opacity", "1"), label) * opacity
     return (red, green, blue, min(max(alpha, 0.0), 1.0))
+
+
+def _check_fill_rule(values: dict[str, Any], label: str) -> None:
+    fill_rule = str(values.get("fill-rule", "nonzero")).strip()
+    if fill_rule != "nonzero":
+        raise InputError(f"{label}: fill-rule={fill_rule!r} is not supported")
+
+
+def _user_to_pixels(transform: Any, geometry: _Geometry) -> tuple[np.ndarray, np.ndarray]:
+    """(linear, shift): a shape's user units to canvas pixels, ``x ↦ linear @ x + shift``."""
+    scale = np.diag(geometry.scale)
+    linear = scale @ np.array([[transform.a, transform.c], [transform.b, transform.d]], float)
+    shift = scale @ (np.array([transform.e, transform.f], float) - geometry.view[:2])
+    return linear, shift + np.asarray(geometry.offset)
 
 
 def _colour(text: str, label: str) -> _Rgba:

@@ -11,6 +11,7 @@ from samvg.render._paint_kernels import FLAT, LINEAR, PARAMS, RADIAL
 from samvg.render.rasterizer import GradientPaints
 from samvg.scene import FlatPaint, LinearGradient, RadialGradient, Scene
 from samvg.svg.writer import scene_to_svg
+from samvg.vector_image import VectorImage
 
 SIZE = 24
 
@@ -161,3 +162,12 @@ def test_our_render_of_a_gradient_scene_agrees_with_resvg_of_its_svg(seed):
     ours = scene.render()
     theirs = resvg_render(svg)
     assert np.abs(ours - theirs).mean() <= 1 / 255
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_gradient_scenes_round_trip_through_svg(seed):
+    scene = random_gradient_scene(seed)
+    back = VectorImage.from_svg(scene_to_svg(scene, precision=4)).scene
+    assert [type(paint) for paint in back.paints] == [type(paint) for paint in scene.paints]
+    assert np.allclose(back.points, scene.points, atol=1e-4)
+    assert np.abs(back.render() - scene.render()).mean() < 0.5 / 255  # 8-bit stop colours

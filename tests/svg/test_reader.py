@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from samvg.errors import InputError
+from samvg.scene import LinearGradient, RadialGradient
 from samvg.svg.reader import ParsedSvg, read_svg
 
 GOLDEN = Path(__file__).parents[1] / "data" / "golden"
@@ -470,7 +471,35 @@ def test_svg_without_namespace_doctype_and_xml_declaration_are_read():
         ('<path d="M0 0 L5 5 L0 5 Z L3 3"/>', "several subpaths"),
         (f'<path id="p1" {TRIANGLE} stroke="#000"/>', "svg/path[1] (id='p1'): strokes"),
         (f'<g style="stroke:red"><path {TRIANGLE}/></g>', "strokes are not supported"),
-        (f'<path {TRIANGLE} fill="url(#g)"/>', "fill='url(#g)' is not supported (only solid"),
+        (f'<path {TRIANGLE} fill="url(#g)"/>', "fill='url(#g)' names no gradient"),
+        (
+            '<linearGradient id="g"><stop offset="0"/><stop offset="1" stop-color="red"/>'
+            f'</linearGradient><path {TRIANGLE} fill="url(#g)"/>',
+            'only gradientUnits="userSpaceOnUse"',
+        ),
+        (
+            '<linearGradient id="g" gradientUnits="userSpaceOnUse" '
+            'gradientTransform="scale(2)">'
+            f'<stop offset="0"/><stop offset="1"/></linearGradient><path {TRIANGLE} fill="url(#g)"/>',
+            "'gradientTransform' is not supported",
+        ),
+        (
+            '<linearGradient id="g" gradientUnits="userSpaceOnUse"><stop offset="0"/>'
+            '<stop offset="1" stop-opacity="0.5"/></linearGradient>'
+            f'<path {TRIANGLE} fill="url(#g)"/>',
+            "translucent gradient stops",
+        ),
+        (
+            '<radialGradient id="g" gradientUnits="userSpaceOnUse" r="3"><stop offset="0"/>'
+            '<stop offset="1"/></radialGradient>'
+            f'<path {TRIANGLE} fill="url(#g)" transform="scale(2 1)"/>',
+            "skewed or stretched transform",
+        ),
+        (
+            '<radialGradient id="g" gradientUnits="userSpaceOnUse" r="3"><stop offset="0"/>'
+            f'</radialGradient><path {TRIANGLE} fill="url(#g)"/>',
+            "2 to 4 stops",
+        ),
         (f'<path {TRIANGLE} fill="none"/>', "only solid fills"),
         (f'<path {TRIANGLE} fill="notacolour"/>', "cannot read fill colour 'notacolour'"),
         (f'<path {TRIANGLE} fill="#12345"/>', "cannot read fill colour"),
@@ -601,3 +630,26 @@ def test_root_outside_the_svg_namespace_and_a_hidden_root():
 def test_font_relative_lengths_are_refused():
     with pytest.raises(InputError, match="em and ex lengths are not supported"):
         read_svg(svg('<circle cx="2em" cy="1" r="1"/>'))
+
+
+def test_gradient_fills_read_back_in_canvas_pixels():
+    text = (
+        '<svg xmlns="http://www.w3.org/2000/svg" width="20" height="20" viewBox="0 0 10 10">'
+        '<linearGradient id="a" gradientUnits="userSpaceOnUse" x1="1" y1="2" x2="9" y2="2">'
+        '<stop offset="0" stop-color="#ff0000"/><stop offset="50%" style="stop-color:#00ff00"/>'
+        '<stop offset="1" stop-color="blue"/></linearGradient>'
+        '<radialGradient id="b" gradientUnits="userSpaceOnUse" cx="5" cy="5" r="2">'
+        '<stop offset="0.2" stop-color="white"/><stop offset="0.1" stop-color="black"/>'
+        "</radialGradient>"
+        '<path d="M0 0 L8 0 L8 8 Z" fill="url(#a)" fill-opacity="0.5"/>'
+        '<path d="M0 0 L4 0 L4 4 Z" fill="url(#b)" transform="translate(1 1) rotate(90)"/>'
+        "</svg>"
+    )
+    (_, linear), (_, radial) = read_svg(text).paths
+    assert isinstance(linear, LinearGradient) and isinstance(radial, RadialGradient)
+    assert linear.start == pytest.approx((2, 4)) and linear.end == pytest.approx((18, 4))
+    assert [offset for offset, _ in linear.stops] == [0.0, 0.5, 1.0] and linear.opacity == 0.5
+    assert linear.stops[1][1] == pytest.approx((0, 1, 0))
+    # rotate(90) maps (5, 5) to (-5, 5), translate(1 1) to (-4, 6): (-8, 12) in pixels
+    assert radial.centre == pytest.approx((-8, 12)) and radial.radius == pytest.approx(4)
+    assert [offset for offset, _ in radial.stops] == [0.2, 0.2]  # offsets never fall
