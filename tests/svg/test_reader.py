@@ -480,7 +480,8 @@ def test_svg_without_namespace_doctype_and_xml_declaration_are_read():
         (
             '<linearGradient id="g" gradientUnits="userSpaceOnUse" '
             'gradientTransform="scale(2)">'
-            f'<stop offset="0"/><stop offset="1"/></linearGradient><path {TRIANGLE} fill="url(#g)"/>',
+            '<stop offset="0"/><stop offset="1"/></linearGradient>'
+            f'<path {TRIANGLE} fill="url(#g)"/>',
             "'gradientTransform' is not supported",
         ),
         (
