@@ -3,7 +3,8 @@ leaves the picture unchanged.
 
 Candidate pairs are paths within ``MERGE_DISTANCE`` px of each other (``shapely.STRtree`` with
 ``dwithin``) whose fills differ by less than ``delta_e`` (CIE76 ΔE in CIELAB,
-``skimage.color.rgb2lab``) with equal opacity; closest colours first. A pair merges only when no
+``skimage.color.rgb2lab``) with equal opacity, both flat (a gradient fill never merges);
+closest colours first. A pair merges only when no
 path painted between them in paint order intersects either (so lifting the lower one to the
 upper one's place changes no pixel), when they meet along at least ``MIN_CONTACT`` px (not at a
 point) and their union is one polygon without holes (a gap under ``MERGE_DISTANCE`` is closed
@@ -76,7 +77,8 @@ def _candidate_pairs(
     lab = rgb2lab(rgba[None, :, :3])[0]
     distance = np.linalg.norm(lab[pairs[:, 0]] - lab[pairs[:, 1]], axis=1)
     alpha = np.abs(rgba[pairs[:, 0], 3] - rgba[pairs[:, 1], 3])
-    keep = (distance < delta_e) & (alpha <= ALPHA_TOLERANCE)
+    flat = np.array([isinstance(paths.paints[i], FlatPaint) for i in live])
+    keep = (distance < delta_e) & (alpha <= ALPHA_TOLERANCE) & flat[pairs[:, 0]] & flat[pairs[:, 1]]
     return pairs[keep][np.argsort(distance[keep], kind="stable")]
 
 

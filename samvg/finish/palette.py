@@ -1,5 +1,6 @@
 """Palette: snap the fills of a scene to ``n`` colours, by k-means in CIELAB weighted by the
-area each path paints (scikit-learn ``KMeans``); opacity is kept."""
+area each path paints (scikit-learn ``KMeans``); opacity is kept, gradient fills are left as
+they are."""
 
 from __future__ import annotations
 
@@ -38,7 +39,10 @@ def snap_colours(scene: Scene, n: int) -> tuple[Scene, dict[str, int]]:
     centres = np.clip(lab2rgb(kmeans.cluster_centers_[None])[0], 0.0, 1.0)
     snapped = colours.copy()
     snapped[:, :3] = centres[labels]
-    paints = tuple(FlatPaint(tuple(row)) for row in snapped)
+    paints = tuple(
+        FlatPaint(tuple(row)) if isinstance(paint, FlatPaint) else paint  # gradients stay
+        for row, paint in zip(snapped, scene.paints, strict=True)
+    )
     changed = int(np.sum(np.any(snapped != colours, axis=1)))
     result = Scene(
         scene.width,

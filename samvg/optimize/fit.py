@@ -14,6 +14,8 @@ from samvg.config import FitOptions
 from samvg.errors import InputError, SamvgError
 from samvg.optimize.losses import PerceptualLoss, lpips_loss, segment_indices, xing_loss
 from samvg.render import rasterize
+from samvg.render._paint_kernels import MAX_STOPS, RADIAL
+from samvg.render.rasterizer import GradientPaints
 from samvg.scene import Scene
 
 _DIVERGED = "optimization diverged (non-finite coordinates); try a lower learning rate"
@@ -109,6 +111,79 @@ def _check_target(target: np.ndarray, scene: Scene) -> torch.Tensor:
     return torch.from_numpy(np.ascontiguousarray(array))
 
 
+class _Parameters:
+    """What Adam moves: packed points, RGBA colours and, for a scene with gradient paints, their
+    geometry (pixels, the points' learning rate) and their stop offsets and colours (the
+    colours' learning rate)."""
+
+    def __init__(self, scene: Scene, settings: FitSettings) -> None:
+        self.scene = scene
+        self.points = torch.tensor(scene.points, dtype=torch.float32, requires_grad=True)
+        colours = scene.colours()
+        if not settings.learn_alpha:
+            colours[:, 3] = 1.0
+        self.colours = torch.tensor(colours, dtype=torch.float32, requires_grad=True)
+        self.gradients: GradientPaints | None = None
+        self.paint_geometry = self.paint_values = torch.zeros(0)
+        if scene.has_gradients:
+            self.gradients = GradientPaints.of(scene.paints)
+            params = self.gradients.params.to(torch.float32)
+            self.paint_geometry = params[:, :4].clone().requires_grad_(True)
+            self.paint_values = params[:, 4:].clone().requires_grad_(True)
+
+    def optimizer(self, settings: FitSettings) -> torch.optim.Adam:
+        point_group = [self.points]
+        colour_group = [self.colours]
+        if self.gradients is not None:
+            point_group.append(self.paint_geometry)
+            colour_group.append(self.paint_values)
+        return torch.optim.Adam(
+            [
+                {"params": point_group, "lr": settings.point_learning_rate},
+                {"params": colour_group, "lr": settings.colour_learning_rate},
+            ]
+        )
+
+    def render(self) -> torch.Tensor:
+        gradients = None
+        if self.gradients is not None:
+            params = torch.cat([self.paint_geometry, self.paint_values], dim=1)
+            gradients = GradientPaints(self.gradients.kinds, self.gradients.stops, params)
+        scene = self.scene
+        return rasterize(
+            self.points,
+            self.colours,
+            scene.width,
+            scene.height,
+            background=scene.background_or_white,
+            offsets=scene.offsets,
+            gradients=gradients,
+        )
+
+    @torch.no_grad()
+    def project(self, settings: FitSettings) -> None:
+        _project(self.points, self.colours, settings)
+        if self.gradients is not None:
+            self.paint_values.clamp_(0.0, 1.0)
+            offsets = self.paint_values[:, :MAX_STOPS]
+            offsets.copy_(torch.cummax(offsets, dim=1).values)
+            radial = torch.from_numpy(self.gradients.kinds == RADIAL)
+            self.paint_geometry[radial, 2] = self.paint_geometry[radial, 2].clamp(min=0.5)
+            if not bool(torch.isfinite(self.paint_geometry).all()):
+                raise SamvgError(_DIVERGED)
+
+    def fitted(self) -> Scene:
+        points = self.points.detach().numpy().astype(np.float64)
+        colours = self.colours.detach().numpy().astype(np.float64)
+        if not (np.all(np.isfinite(points)) and np.all(np.isfinite(colours))):
+            raise SamvgError(_DIVERGED)
+        if self.gradients is None:
+            return self.scene.with_geometry(points, colours)
+        params = torch.cat([self.paint_geometry, self.paint_values], dim=1).detach()
+        paints = GradientPaints(self.gradients.kinds, self.gradients.stops, params).paints(colours)
+        return replace(self.scene, points=points, paints=paints)
+
+
 def _project(points: torch.Tensor, colours: torch.Tensor, settings: FitSettings) -> None:
     """After a step: colours back into [0, 1] (alpha to 1 unless learned), points into the
     bounds; non-finite points mean the fit diverged."""
@@ -129,52 +204,33 @@ def fit_scene(
     settings: FitSettings,
     on_step: StepCallback | None = None,
 ) -> FitResult:
-    """Fit the scene's geometry and flat colours to ``target`` (H, W, 3) float in [0, 1].
+    """Fit the scene's geometry and paints (flat colours, gradient geometry, stops) to
+    ``target`` (H, W, 3) float in [0, 1].
 
     Colours are clamped to [0, 1] after every step; a fit that diverges to non-finite values
     raises `SamvgError`.
     """
     target_tensor = _check_target(target, scene)
-    point_tensor = torch.tensor(scene.points, dtype=torch.float32, requires_grad=True)
-    colours = scene.colours()
-    if not settings.learn_alpha:
-        colours[:, 3] = 1.0
-    colour_tensor = torch.tensor(colours, dtype=torch.float32, requires_grad=True)
+    parameters = _Parameters(scene, settings)
     losses: list[float] = []
     if settings.steps > 0 and scene.path_count > 0:
-        optimizer = torch.optim.Adam(
-            [
-                {"params": [point_tensor], "lr": settings.point_learning_rate},
-                {"params": [colour_tensor], "lr": settings.colour_learning_rate},
-            ]
-        )
+        optimizer = parameters.optimizer(settings)
         indices = segment_indices(scene.offsets)
-        background = scene.background_or_white
         with single_torch_thread():
             for step in range(settings.steps):
                 optimizer.zero_grad(set_to_none=True)
-                rendered = rasterize(
-                    point_tensor,
-                    colour_tensor,
-                    scene.width,
-                    scene.height,
-                    background=background,
-                    offsets=scene.offsets,
-                )
+                rendered = parameters.render()
                 loss = torch.mean((rendered - target_tensor) ** 2)
                 if settings.xing_weight > 0:
-                    loss = loss + settings.xing_weight * xing_loss(point_tensor, indices=indices)
+                    loss = loss + settings.xing_weight * xing_loss(
+                        parameters.points, indices=indices
+                    )
                 if settings.perceptual is not None and settings.perceptual_weight > 0:
                     loss = loss + settings.perceptual_weight * settings.perceptual(rendered)
                 loss.backward()
                 optimizer.step()
-                with torch.no_grad():
-                    _project(point_tensor, colour_tensor, settings)
+                parameters.project(settings)
                 losses.append(float(loss.detach()))
                 if on_step is not None:
                     on_step(step, losses[-1])
-    points = point_tensor.detach().numpy().astype(np.float64)
-    colours = colour_tensor.detach().numpy().astype(np.float64)
-    if not (np.all(np.isfinite(points)) and np.all(np.isfinite(colours))):
-        raise SamvgError(_DIVERGED)
-    return FitResult(scene.with_geometry(points, colours), losses)
+    return FitResult(parameters.fitted(), losses)

@@ -19,7 +19,7 @@ import torch
 from samvg.errors import InputError
 from samvg.render import _kernels as K
 from samvg.render._paint_kernels import FLAT, LINEAR, MAX_STOPS, PARAMS, RADIAL
-from samvg.scene import FlatPaint, LinearGradient, Paint, Scene
+from samvg.scene import FlatPaint, LinearGradient, Paint, RadialGradient, Scene
 
 #: Maximum chord error (pixels) of the polyline that replaces each cubic segment.
 FLATTEN_TOLERANCE = 0.05
@@ -156,6 +156,31 @@ class GradientPaints:
                 params[index, 4 + number] = offset
                 params[index, 8 + 3 * number : 11 + 3 * number] = rgb
         return cls(kinds, stops, torch.from_numpy(params))
+
+    def paints(self, colours: np.ndarray) -> tuple[Paint, ...]:
+        """Scene paints from these rows and RGBA ``colours`` (P, 4): flat fills from the
+        colours, gradients from the parameters with the colours' alpha as opacity."""
+        params = self.params.detach().cpu().numpy().astype(np.float64)
+        rgba = np.clip(np.asarray(colours, dtype=np.float64), 0.0, 1.0)
+        paints: list[Paint] = []
+        for index, kind in enumerate(self.kinds):
+            if kind == FLAT:
+                paints.append(FlatPaint(tuple(rgba[index])))
+                continue
+            row, count = params[index], int(self.stops[index])
+            offsets = np.maximum.accumulate(np.clip(row[4 : 4 + count], 0.0, 1.0))
+            colour_rows = np.clip(row[8 : 8 + 3 * count].reshape(count, 3), 0.0, 1.0)
+            stops = tuple(
+                (float(offset), (float(c[0]), float(c[1]), float(c[2])))
+                for offset, c in zip(offsets, colour_rows, strict=True)
+            )
+            opacity = float(rgba[index, 3])
+            if kind == LINEAR:
+                paints.append(LinearGradient(stops, opacity, tuple(row[0:2]), tuple(row[2:4])))
+            else:
+                radius = max(float(row[2]), 1e-6)
+                paints.append(RadialGradient(stops, opacity, tuple(row[0:2]), radius))
+        return tuple(paints)
 
     @classmethod
     def flat(cls, count: int) -> GradientPaints:

@@ -47,3 +47,27 @@ def test_diverging_fit_is_a_clear_error():
     one = scene_of([(square(1, 1, 4), (0, 0, 0, 1))], size=8)
     with pytest.raises(SamvgError, match="diverged"):
         fit_scene(one, np.zeros((8, 8, 3)), FitSettings(steps=3, point_learning_rate=float("inf")))
+
+
+def test_a_gradient_paint_is_fitted_with_the_geometry():
+    from samvg.scene import LinearGradient, RadialGradient
+
+    square = np.array([[2, 2], [14, 2], [26, 2], [30, 2], [30, 14], [30, 30],
+                       [30, 30], [16, 30], [2, 30], [2, 30], [2, 16], [2, 2]], float)  # fmt: skip
+    stops = ((0.0, (0.9, 0.2, 0.1)), (1.0, (0.1, 0.3, 0.9)))
+    truth = LinearGradient(stops, 1.0, (6.0, 4.0), (26.0, 28.0))
+    target = Scene.from_paths(32, 32, [(square, truth)], background=(1, 1, 1)).render()
+    guess_stops = ((0.1, (0.5, 0.5, 0.5)), (0.9, (0.4, 0.4, 0.4)))
+    for guess in (
+        LinearGradient(guess_stops, 1.0, (4.0, 16.0), (28.0, 16.0)),
+        RadialGradient(guess_stops, 1.0, (16.0, 16.0), 20.0),
+    ):
+        start = Scene.from_paths(32, 32, [(square, guess)], background=(1, 1, 1))
+        settings = FitSettings(steps=150, point_learning_rate=0.2, colour_learning_rate=0.02)
+        result = fit_scene(start, target, settings)
+        fitted = result.scene.paints[0]
+        assert type(fitted) is type(guess)  # the paint kind is kept
+        before = np.mean((start.render() - target) ** 2)
+        after = np.mean((result.scene.render() - target) ** 2)
+        assert after < before / 3
+    assert after < before  # the radial one does what it can
