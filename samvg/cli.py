@@ -156,6 +156,8 @@ def _config(arguments: argparse.Namespace) -> Config:
         settings["filter_by_impact"] = False
     if arguments.translucent:
         settings["translucent"] = True
+    if arguments.gradients:
+        settings["gradients"] = True
     if arguments.no_finish:
         settings["finish_pass"] = False
     preset = "fast" if arguments.fast else arguments.preset
@@ -428,6 +430,11 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
         "--translucent",
         action="store_true",
         help="learn each fill's opacity (default: opaque fills, unless the input has alpha)",
+    )
+    vectorize.add_argument(
+        "--gradients",
+        action="store_true",
+        help="let paths take linear or radial gradient fills where they pay for their parameters",
     )
     vectorize.add_argument(
         "--no-finish",

@@ -149,13 +149,23 @@ class FitOptions:
     margin: float | None = 0.02
     """Keep control points within the canvas plus this fraction of its longer side (None: no
     bound, the paper's setting)."""
+    gradients: bool = False
+    """Offer each flat path a linear or radial gradient fill before each fitting phase."""
+    gradient_cost: float = 1e-6
+    """MSE a gradient must remove per parameter it adds over a flat fill."""
 
     def __post_init__(self) -> None:
         _check_integer(self, "iterations", 0)
         if self.margin is not None:
             _check_non_negative(self, "margin")
         _check_integer(self, "lpips_size", 32)
-        for name in ("point_learning_rate", "colour_learning_rate", "xing_weight", "lpips_weight"):
+        for name in (
+            "point_learning_rate",
+            "colour_learning_rate",
+            "xing_weight",
+            "lpips_weight",
+            "gradient_cost",
+        ):
             _check_non_negative(self, name)
 
     @property

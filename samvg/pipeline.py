@@ -38,7 +38,7 @@ from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.reduce import reduce_paths
 from samvg.optimize.reshape import reshape_scene
 from samvg.sam import SPECS
-from samvg.scene import Frame, Scene
+from samvg.scene import FlatPaint, Frame, Scene
 from samvg.segment import Segmenter, SegmentSettings, select_masks
 from samvg.trace.stage import (
     TraceSettings,
@@ -445,6 +445,9 @@ def _finish(scene: Scene, target: np.ndarray, result: PipelineResult, simple: bo
     result.image = VectorImage.from_scene(simple_when_saved(output) if simple else output)
     result.mse = float(np.mean((scene.render() - target) ** 2))
     result.counts["paths"] = result.image.scene.path_count
+    result.counts["gradient_fills"] = sum(
+        not isinstance(paint, FlatPaint) for paint in result.image.scene.paints
+    )
 
 
 def vectorize(

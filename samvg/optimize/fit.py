@@ -13,6 +13,7 @@ import torch
 from samvg.config import FitOptions
 from samvg.errors import InputError, SamvgError
 from samvg.optimize.losses import PerceptualLoss, lpips_loss, segment_indices, xing_loss
+from samvg.optimize.paint_choice import choose_gradients
 from samvg.render import rasterize
 from samvg.render._paint_kernels import MAX_STOPS, RADIAL
 from samvg.render.rasterizer import GradientPaints
@@ -42,6 +43,9 @@ class FitSettings:
     perceptual_weight: float = 0.0
     learn_alpha: bool = True
     bounds: tuple[float, float, float, float] | None = None
+    gradient_cost: float | None = None
+    """Offer every flat path a gradient fill before fitting (`samvg.optimize.paint_choice`),
+    bought when it removes this much MSE per added parameter; None: fills stay as they are."""
 
     @classmethod
     def from_options(
@@ -70,6 +74,7 @@ class FitSettings:
             perceptual_weight=options.lpips_weight if perceptual is not None else 0.0,
             learn_alpha=options.translucent,
             bounds=bounds,
+            gradient_cost=options.gradient_cost if options.gradients else None,
         )
 
     def with_steps(self, steps: int) -> FitSettings:
@@ -205,12 +210,15 @@ def fit_scene(
     on_step: StepCallback | None = None,
 ) -> FitResult:
     """Fit the scene's geometry and paints (flat colours, gradient geometry, stops) to
-    ``target`` (H, W, 3) float in [0, 1].
+    ``target`` (H, W, 3) float in [0, 1], after offering flat paths a gradient when
+    ``settings.gradient_cost`` is set.
 
     Colours are clamped to [0, 1] after every step; a fit that diverges to non-finite values
     raises `SamvgError`.
     """
     target_tensor = _check_target(target, scene)
+    if settings.gradient_cost is not None:
+        scene, _ = choose_gradients(scene, np.asarray(target), settings.gradient_cost)
     parameters = _Parameters(scene, settings)
     losses: list[float] = []
     if settings.steps > 0 and scene.path_count > 0:
