@@ -3,7 +3,9 @@
 Random scenes of P star-shaped closed paths (K = 4 cubic segments, radius 5-60 px, random
 translucent colours) at 256x256 and 512x512. For each: forward ms (no grad), forward+backward ms
 (MSE loss against a random target image, gradients w.r.t. points and colours) and resvg-py's time
-to render the same SVG text (what ``VectorImage.to_svg`` writes) to PNG; medians of repeats.
+to render the same SVG text (what ``VectorImage.to_svg`` writes) to PNG; medians of repeats. The
+same scenes with every fill a gradient (linear and radial alternately, 3 stops; gradients also
+w.r.t. their parameters) give the gradient columns.
 
 Usage: python benchmarks/bench_render.py [--repeats N] [--torch-threads T] [--out FILE]
 """
@@ -22,6 +24,8 @@ import resvg_py
 import torch
 
 from samvg.render import rasterize, warmup
+from samvg.render._paint_kernels import LINEAR, PARAMS, RADIAL
+from samvg.render.rasterizer import GradientPaints
 from samvg.vector_image import VectorImage, VectorPath
 
 SIZES = (256, 512)
@@ -42,6 +46,18 @@ def scene(rng: np.random.Generator, n_paths: int, size: int) -> tuple[np.ndarray
     colors = rng.uniform(0, 1, (n_paths, 4))
     colors[:, 3] = rng.uniform(0.3, 1.0, n_paths)
     return points, colors
+
+
+def gradient_paints(rng: np.random.Generator, n_paths: int, size: int) -> GradientPaints:
+    """Every path a 3-stop gradient: linear for even paths, radial for odd ones."""
+    params = np.zeros((n_paths, PARAMS))
+    kinds = np.where(np.arange(n_paths) % 2 == 0, LINEAR, RADIAL)
+    params[:, :4] = rng.uniform(0, size, (n_paths, 4))
+    params[kinds == RADIAL, 2] = rng.uniform(10, size / 2, int(np.sum(kinds == RADIAL)))
+    params[:, 4:7] = np.sort(rng.uniform(0, 1, (n_paths, 3)), axis=1)
+    params[:, 8:17] = rng.uniform(0, 1, (n_paths, 9))
+    tensor = torch.tensor(params, dtype=torch.float32, requires_grad=True)
+    return GradientPaints(kinds.astype(np.int64), np.full(n_paths, 3, np.int64), tensor)
 
 
 def median_ms(function, repeats: int) -> float:
@@ -82,12 +98,27 @@ def run(repeats: int) -> list[dict[str, float]]:
             def resvg(svg=svg) -> None:
                 resvg_py.svg_to_bytes(svg_string=svg, background="#ffffff")
 
+            paints = gradient_paints(rng, n_paths, size)
+
+            def gradient_forward(pts=pts, cols=cols, size=size, paints=paints) -> None:
+                with torch.no_grad():
+                    rasterize(pts, cols, size, size, gradients=paints)
+
+            def gradient_forward_backward(
+                pts=pts, cols=cols, size=size, target=target, paints=paints
+            ) -> None:
+                pts.grad = cols.grad = paints.params.grad = None
+                image = rasterize(pts, cols, size, size, gradients=paints)
+                ((image - target) ** 2).mean().backward()
+
             row = {
                 "size": size,
                 "paths": n_paths,
                 "forward": median_ms(forward, repeats),
                 "forward_backward": median_ms(forward_backward, repeats),
                 "resvg": median_ms(resvg, repeats),
+                "gradient_forward": median_ms(gradient_forward, repeats),
+                "gradient_forward_backward": median_ms(gradient_forward_backward, repeats),
             }
             row["ratio"] = row["forward_backward"] / row["resvg"]
             rows.append(row)
@@ -102,13 +133,14 @@ def run(repeats: int) -> list[dict[str, float]]:
 def table(rows: list[dict[str, float]]) -> str:
     lines = [
         "| canvas | paths (K=4) | forward ms | forward+backward ms | resvg-py ms "
-        "| fwd+bwd / resvg |",
-        "|---|---:|---:|---:|---:|---:|",
+        "| fwd+bwd / resvg | gradient fills: forward ms | gradient fills: fwd+bwd ms |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         lines.append(
             f"| {r['size']}x{r['size']} | {r['paths']} | {r['forward']:.2f} | "
-            f"{r['forward_backward']:.2f} | {r['resvg']:.2f} | {r['ratio']:.2f} |"
+            f"{r['forward_backward']:.2f} | {r['resvg']:.2f} | {r['ratio']:.2f} | "
+            f"{r['gradient_forward']:.2f} | {r['gradient_forward_backward']:.2f} |"
         )
     return "\n".join(lines)
 

@@ -32,17 +32,17 @@ _TINY = 1e-12
 
 @njit(cache=True, nogil=True)
 def _parameter(
-    kind: int, g: np.ndarray, px: float, py: float
+    kind: int, g0: float, g1: float, g2: float, g3: float, px: float, py: float
 ) -> tuple[float, float, float, float, float]:
     """(t, dt/dg0, dt/dg1, dt/dg2, dt/dg3) at (px, py); derivatives 0 where t is clamped."""
     if kind == LINEAR:
-        dx = g[2] - g[0]
-        dy = g[3] - g[1]
+        dx = g2 - g0
+        dy = g3 - g1
         length2 = dx * dx + dy * dy
         if length2 < _TINY:
             return 1.0, 0.0, 0.0, 0.0, 0.0  # SVG: a zero-length vector paints the last stop
-        rx = px - g[0]
-        ry = py - g[1]
+        rx = px - g0
+        ry = py - g1
         n = rx * dx + ry * dy
         t = n / length2
         if t <= 0.0 or t >= 1.0:
@@ -54,9 +54,9 @@ def _parameter(
         d2 = (rx - t * (2.0 * dx)) * inv
         d3 = (ry - t * (2.0 * dy)) * inv
         return t, d0, d1, d2, d3
-    radius = g[2]
-    rx = px - g[0]
-    ry = py - g[1]
+    radius = g2
+    rx = px - g0
+    ry = py - g1
     distance = math.sqrt(rx * rx + ry * ry)
     if radius < _TINY:
         return 1.0, 0.0, 0.0, 0.0, 0.0
@@ -88,7 +88,7 @@ def paint_colour(
     kinds: np.ndarray, stops: np.ndarray, params: np.ndarray, p: int, px: float, py: float
 ) -> tuple[float, float, float]:
     """The RGB of gradient paint ``p`` at (px, py)."""
-    t = _parameter(kinds[p], params[p, 0:4], px, py)[0]
+    t = _parameter(kinds[p], params[p, 0], params[p, 1], params[p, 2], params[p, 3], px, py)[0]
     j, w, span = _segment(params, p, stops[p], t)
     if j < 0:
         return params[p, 8], params[p, 9], params[p, 10]
@@ -110,7 +110,9 @@ def paint_backward(
     gr: float, gg: float, gb: float, gparams: np.ndarray,
 ) -> None:  # fmt: skip
     """Add dL/d params of paint ``p`` to ``gparams[p]``, given dL/d its colour at (px, py)."""
-    t, d0, d1, d2, d3 = _parameter(kinds[p], params[p, 0:4], px, py)
+    t, d0, d1, d2, d3 = _parameter(
+        kinds[p], params[p, 0], params[p, 1], params[p, 2], params[p, 3], px, py
+    )
     j, w, span = _segment(params, p, stops[p], t)
     if j < 0 or span == 0.0:
         base = 8 + 3 * (0 if j < 0 else j)
