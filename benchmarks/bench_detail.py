@@ -1,7 +1,8 @@
 """Detail at any path budget (issue 11): samvg at N paths against VTracer tuned to N paths, the
-LIVE-style baseline and random init (diffvg) at N; a rate-distortion sweep for photos and
-paintings; and the report, which also holds the default against VTracer's default settings
-(from the records of ``bench_geometry.py --settings default``).
+LIVE-style baseline and random init (diffvg) at N, and samvg with gradient fills at N (issue
+13); a rate-distortion sweep for photos and paintings (flat and with gradients); and the report,
+which also holds the default against VTracer's default settings (from the records of
+``bench_geometry.py --settings default``).
 
     python benchmarks/bench_detail.py budget --per-category 4 --paths 16,64
     python benchmarks/bench_detail.py rate --per-category 4
@@ -117,9 +118,9 @@ def run_budget(entries: list[dict[str, str]], budgets: list[int], methods: list[
         for entry in entries:
             for method in methods:
                 extra = {"study": "budget", "method": method, "budget": budget}
-                if method == "samvg":
-                    config = samvg.Config(paths=budget)
-                    save(f"samvg.{budget}", entry, extra, samvg_record, config, lpips)
+                if method in ("samvg", "samvg-gradients"):
+                    config = samvg.Config(paths=budget, gradients=method == "samvg-gradients")
+                    save(f"{method}.{budget}", entry, extra, samvg_record, config, lpips)
                 else:
                     save(f"{method}.{budget}", entry, extra, baseline_record, method, budget, lpips)
 
@@ -132,9 +133,10 @@ def run_rate(entries: list[dict[str, str]], budgets: list[int]) -> None:
             extra = {"study": "rate", "method": "vtracer", "setting": tag}
             save(f"rate.vtracer.{tag}", entry, extra, vtracer_record, setting, lpips)
         for budget in budgets:
-            extra = {"study": "rate", "method": "samvg", "setting": str(budget)}
-            config = samvg.Config(paths=budget)
-            save(f"rate.samvg.{budget}", entry, extra, samvg_record, config, lpips)
+            for method in ("samvg", "samvg-gradients"):
+                extra = {"study": "rate", "method": method, "setting": str(budget)}
+                config = samvg.Config(paths=budget, gradients=method == "samvg-gradients")
+                save(f"rate.{method}.{budget}", entry, extra, samvg_record, config, lpips)
 
 
 def main() -> None:
@@ -143,7 +145,7 @@ def main() -> None:
     parser.add_argument("--per-category", type=int, default=4)
     parser.add_argument("--categories", help="comma-separated (default: all six)")
     parser.add_argument("--paths", default="16,64", help="budgets, comma-separated")
-    parser.add_argument("--methods", default="samvg,vtracer,live,diffvg")
+    parser.add_argument("--methods", default="samvg,samvg-gradients,vtracer,live,diffvg")
     arguments = parser.parse_args()
     if arguments.study == "report":
         from detail_report import write_report

@@ -96,7 +96,9 @@ def budget_tables(records: list[dict[str, Any]]) -> list[str]:
     ]
     for budget in sorted({b for b, _ in by_key}):
         complete = {i: m for (b, i), m in by_key.items() if b == budget and "samvg" in m}
-        methods = sorted({name for m in complete.values() for name in m} - {"samvg"})
+        methods = sorted(
+            {name for m in complete.values() for name in m} - {"samvg", "samvg-gradients"}
+        )
         lines += [
             "",
             f"### N = {budget}",
@@ -126,6 +128,50 @@ def budget_tables(records: list[dict[str, Any]]) -> list[str]:
                     f"{1e3 * _mean(group, 'mse'):.2f} | {_mean(group, 'lpips'):.3f} | "
                     f"{_mean(group, 'svg_bytes'):.0f} | {_mean(group, 'seconds'):.1f} | {wins} |"
                 )
+    return lines
+
+
+def gradient_table(records: list[dict[str, Any]]) -> list[str]:
+    """samvg with gradient fills against flat fills at the same budget (issue 13)."""
+    pairs: dict[tuple[int, str], dict[str, dict[str, Any]]] = defaultdict(dict)
+    for row in records:
+        if row.get("study") == "budget" and row["method"] in ("samvg", "samvg-gradients"):
+            pairs[(row["budget"], row["id"])][row["method"]] = row
+    complete = [(b, p) for (b, _), p in pairs.items() if len(p) == 2]
+    if not complete:
+        return []
+    lines = [
+        "",
+        "## Gradient fills against flat fills at equal budgets (issue 13)",
+        "",
+        "`samvg --paths N --gradients` against `samvg --paths N`, same images. *better* = "
+        "images where gradients give lower MSE **and** lower LPIPS.",
+        "",
+        "| N | category | images | flat MSE ×1e-3 | gradients MSE ×1e-3 | flat LPIPS | "
+        "gradients LPIPS | flat bytes | gradients bytes | better |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for budget in sorted({b for b, _ in complete}):
+        for category in (*CATEGORIES, "all"):
+            group = [
+                p
+                for b, p in complete
+                if b == budget and category in ("all", p["samvg"]["category"])
+            ]
+            if not group:
+                continue
+            flat = [p["samvg"] for p in group]
+            shaded = [p["samvg-gradients"] for p in group]
+            better = sum(
+                s["mse"] < f["mse"] and s["lpips"] < f["lpips"]
+                for f, s in zip(flat, shaded, strict=True)
+            )
+            lines.append(
+                f"| {budget} | {category} | {len(group)} | {1e3 * _mean(flat, 'mse'):.2f} | "
+                f"{1e3 * _mean(shaded, 'mse'):.2f} | {_mean(flat, 'lpips'):.3f} | "
+                f"{_mean(shaded, 'lpips'):.3f} | {_mean(flat, 'svg_bytes'):.0f} | "
+                f"{_mean(shaded, 'svg_bytes'):.0f} | {better}/{len(group)} |"
+            )
     return lines
 
 
@@ -181,6 +227,7 @@ def write_report(records_folder: Path, geometry: Path) -> None:
         *default_table(geometry),
         "",
         *budget_tables(records),
+        *gradient_table(records),
         *rate_plot(records),
     ]
     atomic_write_text(REPORT, "\n".join(lines) + "\n")
