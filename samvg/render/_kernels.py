@@ -560,6 +560,37 @@ def _edge_backward(
 
 
 @njit(cache=True, nogil=True)
+def _path_edges_backward(
+    verts: np.ndarray, path_vstart: np.ndarray, p: int, bx0: int, by0: int, bw: int, bh: int,
+    acc: np.ndarray, dcov: np.ndarray, o: int, gverts: np.ndarray,
+) -> None:  # fmt: skip
+    """Add to ``gverts`` what the edges of path ``p`` get from dL/dcov of its box (``dcov``)."""
+    stride = bw + 1
+    v0 = path_vstart[p]
+    n = path_vstart[p + 1] - v0
+    for e in range(n):
+        i = v0 + e
+        j = v0 + e + 1 if e + 1 < n else v0
+        gxa, gya, gxb, gyb = _edge_backward(
+            verts[i, 0] - bx0,
+            verts[i, 1] - by0,
+            verts[j, 0] - bx0,
+            verts[j, 1] - by0,
+            bw,
+            bh,
+            acc,
+            dcov,
+            o,
+            0,
+            stride,
+        )
+        gverts[i, 0] += gxa
+        gverts[i, 1] += gya
+        gverts[j, 0] += gxb
+        gverts[j, 1] += gyb
+
+
+@njit(cache=True, nogil=True)
 def render_backward(
     grad_out: np.ndarray, verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray,
     off: np.ndarray, colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
@@ -628,26 +659,5 @@ def render_backward(
         gcol[p, 1] = sg
         gcol[p, 2] = sb
         gcol[p, 3] = sa
-        v0 = path_vstart[p]
-        n = path_vstart[p + 1] - v0
-        for e in range(n):
-            i = v0 + e
-            j = v0 + e + 1 if e + 1 < n else v0
-            gxa, gya, gxb, gyb = _edge_backward(
-                verts[i, 0] - bx0,
-                verts[i, 1] - by0,
-                verts[j, 0] - bx0,
-                verts[j, 1] - by0,
-                bw,
-                bh,
-                acc,
-                dcov,
-                o,
-                0,
-                stride,
-            )
-            gverts[i, 0] += gxa
-            gverts[i, 1] += gya
-            gverts[j, 0] += gxb
-            gverts[j, 1] += gyb
+        _path_edges_backward(verts, path_vstart, p, bx0, by0, bw, bh, acc, dcov, o, gverts)
     return gverts, gcol, gparams
