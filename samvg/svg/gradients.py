@@ -17,6 +17,7 @@ import numpy as np
 
 from samvg.errors import InputError
 from samvg.scene import MAX_STOPS, LinearGradient, RadialGradient
+from samvg.svg.values import number
 
 _SIMILARITY_TOLERANCE = 1e-9
 ColourParser = Callable[[str, str], tuple[float, float, float, float]]
@@ -41,14 +42,7 @@ def _length(element: ElementTree.Element, name: str, default: str, label: str) -
 
 
 def _stop_offset(text: str, label: str) -> float:
-    stripped = text.strip()
-    try:
-        value = float(stripped.rstrip("%")) / (100.0 if stripped.endswith("%") else 1.0)
-    except ValueError:
-        raise InputError(f"{label}: stop offset {text!r} is not a number") from None
-    if not math.isfinite(value):
-        raise InputError(f"{label}: stop offset {text!r} is not finite")
-    return min(max(value, 0.0), 1.0)
+    return min(max(number(text, label), 0.0), 1.0)
 
 
 def _stops(

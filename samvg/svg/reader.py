@@ -29,6 +29,7 @@ import svgelements
 from samvg.errors import InputError
 from samvg.scene import LinearGradient, RadialGradient
 from samvg.svg.gradients import gradient_paint
+from samvg.svg.values import number
 
 __all__ = ["ParsedSvg", "read_svg"]
 
@@ -477,7 +478,7 @@ def _opacity(element: Any, inherited: float, label: str) -> float:
     for name, harmless in _UNSUPPORTED_ATTRIBUTES.items():
         if str(attributes.get(name, harmless)).strip() != harmless:
             raise InputError(f"{label}: attribute {name!r} is not supported")
-    return inherited * _number(attributes.get("opacity", "1"), label)
+    return inherited * number(attributes.get("opacity", "1"), label)
 
 
 def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
@@ -533,17 +534,6 @@ def _covers_canvas(points: np.ndarray, geometry: _Geometry) -> bool:
 
 
 # ---------------------------------------------------------------------- fills
-def _number(text: str, label: str) -> float:
-    stripped = str(text).strip()
-    try:
-        value = float(stripped.rstrip("%")) / (100.0 if stripped.endswith("%") else 1.0)
-    except ValueError:
-        raise InputError(f"{label}: {text!r} is not a number") from None
-    if not math.isfinite(value):
-        raise InputError(f"{label}: {text!r} is not a finite number")
-    return value
-
-
 def _fill(
     values: dict[str, Any], opacity: float, label: str, scene: _Scene, transform: Any
 ) -> _Fill:
@@ -556,7 +546,7 @@ def _fill(
         if target is None or _local_name(target.tag) not in ("linearGradient", "radialGradient"):
             raise InputError(f"{label}: fill={colour_text!r} names no gradient")
         _check_fill_rule(values, label)
-        alpha = _number(values.get("fill-opacity", "1"), label) * opacity
+        alpha = number(values.get("fill-opacity", "1"), label) * opacity
         alpha = min(max(alpha, 0.0), 1.0)
         return gradient_paint(
             target, _user_to_pixels(transform, scene.geometry), alpha, label, _colour
@@ -565,7 +555,7 @@ def _fill(
         raise InputError(f"{label}: fill={colour_text!r} is not supported (only solid fills)")
     _check_fill_rule(values, label)
     red, green, blue, alpha = _colour(colour_text, label)
-    alpha *= _number(values.get("fill-opacity", "1"), label) * opacity
+    alpha *= number(values.get("fill-opacity", "1"), label) * opacity
     return (red, green, blue, min(max(alpha, 0.0), 1.0))
 
 
