@@ -160,11 +160,12 @@ def write_report(out: Path, names: list[str], report: Path) -> None:
     lines = [
         "# Clean geometry (issue 12)",
         "",
-        "`python benchmarks/bench_geometry.py --per-category 4 --settings default,fixed5`, then "
-        "`--settings default` for the rest of `../shared/bench`, at 512 px; records in "
-        "`benchmarks/results/geometry/`. "
-        "*default*: the product default (adaptive segments, opaque fills, bounded points, finish "
-        "pass). *fixed5*: the same with 5 segments per path when traced and `--max-paths` set to "
+        "`python benchmarks/bench_geometry.py --settings default` (two workers: `--shard 0/2` "
+        "and `--shard 1/2`) on all of `../shared/bench` at 512 px; records in "
+        "`benchmarks/results/geometry/`, each with VTracer's default settings measured on the "
+        "same working image (used by `detail.md`). "
+        "*default*: the product default (colour-coherent parts, stage-4 rounds until the "
+        "`--detail` tolerance, adaptive segments, opaque fills, bounded points, finish pass). *fixed5*: the same with 5 segments per path when traced and `--max-paths` set to "
         "the default's path count (an upper bound: it ends with fewer paths on its own; the "
         "finish pass then redraws repaired outlines, so its segment counts drift from 5). "
         "Counts are totals over the images; other columns are means. "
@@ -175,11 +176,21 @@ def write_report(out: Path, names: list[str], report: Path) -> None:
         f"## The default on {len(defaults)} of the 75 images",
         "",
         *_table(defaults, ["default"]),
-        "",
-        f"## Default against fixed5 on the {len(paired) // max(len(names), 1)} images with both",
-        "",
-        *_table(paired, names),
     ]
+    if len(names) > 1:
+        lines += [
+            "",
+            f"## Default against fixed5 on the {len(paired) // len(names)} images with both",
+            "",
+            *_table(paired, names),
+        ]
+    else:
+        lines += [
+            "",
+            "The comparison with fixed 5 segments per path at equal path counts was measured "
+            "on 24 images at commit 955dc51 (the default before colour parts and stage-4 "
+            "rounds): `geometry_955dc51.md`, records in `geometry/955dc51/`.",
+        ]
     wins = defaultdict(int)
     by_id: dict[str, dict[str, dict[str, Any]]] = defaultdict(dict)
     for record in paired:
