@@ -256,7 +256,7 @@ def _run_stages(
     if budget is not None and config.finish.finish_pass:
         scene = _finish_pass(scene, config, inputs, result, report)  # merges and hidden go first
     if budget is not None:
-        scene = _reduce(scene, inputs, fit, budget, result)
+        scene = _reduce(scene, inputs, fit, budget, result, report)
     if config.finish.finish_pass:
         scene = _finish_pass(scene, config, inputs, result, report)
     if budget is not None:
@@ -360,6 +360,7 @@ def _add_missing(
         pool,
         on_round=lambda count, _round: report("missing", min(count, total), total),
         alpha=inputs.alpha,
+        on_step=_progress_of(report, "refine", settings[2].steps),
     )
     report("missing", total, total)
     result.missing_map, result.missing_prompts = done.error_map, done.prompts
@@ -374,7 +375,12 @@ def _add_missing(
 
 
 def _reduce(
-    scene: Scene, inputs: _Inputs, fit: FitSettings, budget: int, result: PipelineResult
+    scene: Scene,
+    inputs: _Inputs,
+    fit: FitSettings,
+    budget: int,
+    result: PipelineResult,
+    report: ProgressCallback,
 ) -> Scene:
     """The scene cut to ``budget`` paths (those of least removal cost go) and fitted again."""
     if scene.path_count <= budget:
@@ -382,7 +388,7 @@ def _reduce(
     with _timed(result, "reduce"):
         scene, removed = reduce_paths(scene, inputs.target, budget)
         result.counts["reduced"] = result.counts.get("reduced", 0) + removed
-        return fit_scene(scene, inputs.target, fit).scene
+        return fit_scene(scene, inputs.target, fit, _progress_of(report, "reduce", fit.steps)).scene
 
 
 def _box(config: Config, inputs: _Inputs) -> tuple[float, float, float, float]:

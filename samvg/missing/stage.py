@@ -181,6 +181,7 @@ def add_missing_rounds(
     pool: int | None = None,
     on_round: Callable[[int, MissingRound], None] | None = None,
     alpha: np.ndarray | None = None,
+    on_step: StepCallback | None = None,
 ) -> MissingRounds:
     """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
     less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`). With a ``pool`` (a path
@@ -198,7 +199,7 @@ def add_missing_rounds(
         if pool is not None and scene.path_count >= (settings.max_paths or pool):
             done.stopped = f"the pool of {pool} paths is full"
             break
-        round_ = add_missing(scene, target, segmenter, settings, trace, fit, None, alpha)
+        round_ = add_missing(scene, target, segmenter, settings, trace, fit, on_step, alpha)
         done.rounds += 1
         done.added += round_.added
         done.prompt_count += len(round_.prompts)
