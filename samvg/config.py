@@ -143,6 +143,12 @@ class FitOptions:
     lpips_size: int = 128
     """LPIPS is computed on the render resized to this longest side (cost, not quality)."""
     lpips_weights: str | None = None
+    lpips_every: int = 4
+    """Evaluate LPIPS every this many steps; the steps between reuse its last gradient with
+    respect to the render (1: every step, the paper)."""
+    coarse_fraction: float = 0.5
+    """The share of each phase's steps fitted first at half size, coarse to fine (0: none, the
+    paper)."""
     translucent: bool = False
     """Learn each fill's opacity (the paper does); off keeps every fill opaque, except on
     inputs with an alpha channel."""
@@ -159,6 +165,10 @@ class FitOptions:
         if self.margin is not None:
             _check_non_negative(self, "margin")
         _check_integer(self, "lpips_size", 32)
+        _check_integer(self, "lpips_every", 1)
+        _check_non_negative(self, "coarse_fraction")
+        if self.coarse_fraction > 1:
+            raise InputError(f"coarse fraction must be from 0 to 1, got {self.coarse_fraction!r}")
         for name in (
             "point_learning_rate",
             "colour_learning_rate",
@@ -204,6 +214,10 @@ class MissingOptions:
     paths: int | None = None
     """Exactly this many paths when the image holds that much detail: stage 4 grows the scene to
     a larger pool, then the paths of least impact are removed (None: as ``detail`` decides)."""
+    refit_scene: bool = False
+    """Fit the whole scene again after every stage-4 round (the paper). Off, a round fits only
+    the paths it adds, over a fixed render of the rest, and the whole scene is fitted once after
+    the last round."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015
@@ -363,6 +377,9 @@ PAPER: dict[str, Any] = {
     "finish_pass": False,
     "colour_split": False,
     "missing_rounds": 1,
+    "refit_scene": True,
+    "lpips_every": 1,
+    "coarse_fraction": 0.0,
 }
 #: How `Config.fast` differs from the default.
 FAST: dict[str, Any] = {"points_per_side": 16, "size": 384, "iterations": 120, "use_lpips": False}

@@ -139,6 +139,15 @@ def resize_longest(image: np.ndarray, size: int) -> tuple[np.ndarray, float]:
     return resized, new_size[0] / width
 
 
+def halve(image: np.ndarray) -> np.ndarray:
+    """A float (H, W, C) image at half size, each pixel the mean of a 2 × 2 block (an odd last
+    row or column is repeated): (ceil(H / 2), ceil(W / 2), C)."""
+    height, width = image.shape[:2]
+    padded = np.pad(image, ((0, height % 2), (0, width % 2), (0, 0)), mode="edge")
+    blocks = padded.reshape(padded.shape[0] // 2, 2, padded.shape[1] // 2, 2, -1)
+    return blocks.mean(axis=(1, 3), dtype=np.float64).astype(image.dtype)
+
+
 def error_map(target: np.ndarray, render: np.ndarray) -> np.ndarray:
     """D: per-pixel sum over R, G, B of |target − render| (float32, values in [0, 3])."""
     return np.abs(np.asarray(target, np.float32) - np.asarray(render, np.float32)).sum(axis=2)

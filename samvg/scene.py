@@ -349,6 +349,17 @@ class Scene:
             None,
         )
 
+    def on_canvas(self, width: int, height: int, factor: float) -> Scene:
+        """The scene drawn ``factor`` times as large on a ``width`` × ``height`` canvas (points
+        and gradient geometry scaled; paths, paints and frame kept)."""
+        return replace(
+            self,
+            width=width,
+            height=height,
+            points=self.points * factor,
+            paints=tuple(paint.scaled(factor) for paint in self.paints),
+        )
+
     def render(self, scale: float = 1.0) -> np.ndarray:
         """Rasterize to a float32 (H, W, 3) array in [0, 1] at ``scale`` × the canvas size; no
         background means white."""

@@ -7,6 +7,7 @@ from samvg import InputError
 from samvg.imaging import (
     error_map,
     filled_components,
+    halve,
     label_components,
     resize_longest,
     to_float_rgb,
@@ -33,6 +34,15 @@ def test_resize_keeps_small_images_and_scales_the_longer_side():
     assert same is image and scale == 1.0
     smaller, scale = resize_longest(image, 50)
     assert smaller.shape == (25, 50, 3) and scale == 0.25
+
+
+def test_halving_averages_blocks_and_repeats_an_odd_edge():
+    image = np.arange(5 * 3 * 1, dtype=np.float32).reshape(5, 3, 1)
+    half = halve(image)
+    assert half.shape == (3, 2, 1) and half.dtype == np.float32
+    assert half[0, 0, 0] == pytest.approx((0 + 1 + 3 + 4) / 4)
+    assert half[0, 1, 0] == pytest.approx((2 + 2 + 5 + 5) / 4)  # the last column repeated
+    assert half[2, 0, 0] == pytest.approx((12 + 13 + 12 + 13) / 4)  # the last row repeated
 
 
 def test_error_map_sums_channels():

@@ -41,6 +41,18 @@ def test_frame_maps_working_pixels_to_input_pixels():
     np.testing.assert_allclose(out.points, scene.points * 2)
 
 
+def test_a_scene_drawn_at_half_size_on_a_smaller_canvas():
+    from samvg.scene import RadialGradient
+
+    glow = RadialGradient(((0.0, (1, 1, 0)), (1.0, (0, 0, 1))), 1.0, (20.0, 10.0), 8.0)
+    scene = Scene.from_paths(41, 21, [(square(10, 4, 20), glow)], frame=Frame(82, 42, 0.5))
+    half = scene.on_canvas(21, 11, 0.5)
+    assert (half.width, half.height, half.frame) == (21, 11, scene.frame)
+    np.testing.assert_allclose(half.points, scene.points / 2)
+    assert half.paints[0].centre == (10.0, 5.0) and half.paints[0].radius == 4.0
+    np.testing.assert_allclose(half.render(), scene.render()[::2, ::2][:11, :21], atol=0.3)
+
+
 def test_bad_scenes_are_refused():
     with pytest.raises(InputError, match="non-finite"):
         Scene.from_paths(8, 8, [(np.full((3, 2), np.nan), FlatPaint((0, 0, 0)))])

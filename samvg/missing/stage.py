@@ -49,6 +49,8 @@ class MissingSettings:
     """A pixel is wrong when its error (sum over RGB, in [0, 3]) reaches this."""
     gain_tolerance: float = 0.01
     """The automatic rounds stop when a round lowers the MSE by less than this fraction."""
+    refit_scene: bool = True
+    """Each round fits the whole scene (True) or only its new paths over the rest's render."""
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> MissingSettings:
@@ -63,6 +65,7 @@ class MissingSettings:
             max_paths=config.segment.max_paths,
             colour_split=colour_split_settings(config, width, height),
             gain_tolerance=options.gain_tolerance,
+            refit_scene=options.refit_scene,
         )
 
 
@@ -153,7 +156,10 @@ def add_missing(
     result.timings["missing"] = time.perf_counter() - clock
     if added.path_count:
         clock = time.perf_counter()
-        result.scene = fit_scene(scene.stacked(added), target, fit, on_step).scene
+        if settings.refit_scene:
+            result.scene = fit_scene(scene.stacked(added), target, fit, on_step).scene
+        else:
+            result.scene = scene.stacked(fit_scene(added, target, fit, on_step, render).scene)
         result.timings["refine"] = time.perf_counter() - clock
     return result
 
@@ -186,7 +192,9 @@ def add_missing_rounds(
     """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
     less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`). With a ``pool`` (a path
     budget), rounds take the candidates of largest impact, however small, until the scene has
-    ``pool`` paths or a round finds nothing more (at most ``2 * MAX_AUTO_ROUNDS``)."""
+    ``pool`` paths or a round finds nothing more (at most ``2 * MAX_AUTO_ROUNDS``). Unless
+    ``settings.refit_scene``, rounds fit only the paths they add and the whole scene is fitted
+    once at the end."""
     settings, trace, fit = stages
     if pool is not None:
         limit = pool if settings.max_paths is None else min(pool, settings.max_paths)
@@ -218,6 +226,10 @@ def add_missing_rounds(
         if planned is None and pool is None and gain < settings.gain_tolerance:
             done.stopped = f"round {done.rounds} lowered the error by {gain:.1%}"
             break
+    if done.added and not settings.refit_scene:
+        clock = time.perf_counter()
+        scene = fit_scene(scene, target, fit, on_step).scene
+        done.timings["refine"] = done.timings.get("refine", 0.0) + time.perf_counter() - clock
     done.scene = scene
     done.stopped = done.stopped or f"{done.rounds} rounds"
     return done

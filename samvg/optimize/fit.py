@@ -12,6 +12,7 @@ import torch
 
 from samvg.config import FitOptions
 from samvg.errors import InputError, SamvgError
+from samvg.imaging import halve
 from samvg.optimize.losses import PerceptualLoss, lpips_loss, segment_indices, xing_loss
 from samvg.optimize.paint_choice import choose_gradients
 from samvg.render import rasterize
@@ -19,6 +20,8 @@ from samvg.render._paint_kernels import MAX_STOPS, RADIAL
 from samvg.render.rasterizer import GradientPaints
 from samvg.scene import Scene
 
+#: Canvases whose longer side is below this are fitted at full size only.
+COARSE_MIN_SIDE = 128
 _DIVERGED = "optimization diverged (non-finite coordinates); try a lower learning rate"
 
 StepCallback = Callable[[int, float], None]
@@ -43,6 +46,10 @@ class FitSettings:
     perceptual_weight: float = 0.0
     learn_alpha: bool = True
     bounds: tuple[float, float, float, float] | None = None
+    perceptual_every: int = 1
+    """Evaluate LPIPS every this many steps and reuse its gradient in between (1: every step)."""
+    coarse_fraction: float = 0.0
+    """The share of the steps fitted first at half size (0: all at full size)."""
     gradient_cost: float | None = None
     """Offer every flat path a gradient fill before fitting (`samvg.optimize.paint_choice`),
     bought when it removes this much MSE per added parameter; None: fills stay as they are."""
@@ -74,6 +81,8 @@ class FitSettings:
             perceptual_weight=options.lpips_weight if perceptual is not None else 0.0,
             learn_alpha=options.translucent,
             bounds=bounds,
+            perceptual_every=options.lpips_every,
+            coarse_fraction=options.coarse_fraction,
             gradient_cost=options.gradient_cost if options.gradients else None,
         )
 
@@ -121,8 +130,11 @@ class _Parameters:
     geometry (pixels, the points' learning rate) and their stop offsets and colours (the
     colours' learning rate)."""
 
-    def __init__(self, scene: Scene, settings: FitSettings) -> None:
+    def __init__(
+        self, scene: Scene, settings: FitSettings, underlay: np.ndarray | None = None
+    ) -> None:
         self.scene = scene
+        self.underlay = underlay
         self.points = torch.tensor(scene.points, dtype=torch.float32, requires_grad=True)
         colours = scene.colours()
         if not settings.learn_alpha:
@@ -160,7 +172,7 @@ class _Parameters:
             self.colours,
             scene.width,
             scene.height,
-            background=scene.background_or_white,
+            background=scene.background_or_white if self.underlay is None else self.underlay,
             offsets=scene.offsets,
             gradients=gradients,
         )
@@ -208,37 +220,127 @@ def fit_scene(
     target: np.ndarray,
     settings: FitSettings,
     on_step: StepCallback | None = None,
+    underlay: np.ndarray | None = None,
 ) -> FitResult:
     """Fit the scene's geometry and paints (flat colours, gradient geometry, stops) to
     ``target`` (H, W, 3) float in [0, 1], after offering flat paths a gradient when
-    ``settings.gradient_cost`` is set.
+    ``settings.gradient_cost`` is set. With an ``underlay`` (H, W, 3), the paths are painted
+    over that fixed image instead of the scene's background (paths added on top of a scene
+    that stays as it is).
+
+    With ``settings.coarse_fraction`` set, that share of the steps runs first on the scene and
+    target at half size (a quarter of the pixels to draw), the rest at full size.
 
     Colours are clamped to [0, 1] after every step; a fit that diverges to non-finite values
     raises `SamvgError`.
     """
-    target_tensor = _check_target(target, scene)
+    _check_target(target, scene)
+    if underlay is not None:
+        underlay = np.asarray(underlay, np.float64)
+        if underlay.shape != np.shape(target):
+            raise InputError(f"underlay must have the target's shape, got {underlay.shape}")
     if settings.gradient_cost is not None:
         scene, _ = choose_gradients(scene, np.asarray(target), settings.gradient_cost)
-    parameters = _Parameters(scene, settings)
+    coarse = _coarse_steps(scene, settings)
+    losses: list[float] = []
+    if coarse:
+        width, height = -(-scene.width // 2), -(-scene.height // 2)
+        small = _fit_level(
+            scene.on_canvas(width, height, 0.5),
+            halve(np.asarray(target, np.float32)),
+            replace(settings, steps=coarse, bounds=_halved(settings.bounds)),
+            on_step,
+            underlay=None if underlay is None else halve(underlay),
+        )
+        scene = small.scene.on_canvas(scene.width, scene.height, 2.0)
+        losses = small.losses
+        settings = replace(settings, steps=settings.steps - coarse)
+    full = _fit_level(scene, target, settings, on_step, coarse, underlay)
+    return FitResult(full.scene, losses + full.losses)
+
+
+def _coarse_steps(scene: Scene, settings: FitSettings) -> int:
+    """Steps of the half-size level: none for small canvases or short fits."""
+    if max(scene.width, scene.height) < COARSE_MIN_SIDE or scene.path_count == 0:
+        return 0
+    return int(round(settings.steps * settings.coarse_fraction))
+
+
+def _halved(
+    bounds: tuple[float, float, float, float] | None,
+) -> tuple[float, float, float, float] | None:
+    if bounds is None:
+        return None
+    x0, y0, x1, y1 = bounds
+    return (x0 / 2, y0 / 2, x1 / 2, y1 / 2)
+
+
+def _fit_level(
+    scene: Scene,
+    target: np.ndarray,
+    settings: FitSettings,
+    on_step: StepCallback | None = None,
+    first_step: int = 0,
+    underlay: np.ndarray | None = None,
+) -> FitResult:
+    """Adam on one canvas size: ``settings.steps`` steps (progress counted from
+    ``first_step``)."""
+    target_tensor = _check_target(target, scene)
+    parameters = _Parameters(scene, settings, underlay)
     losses: list[float] = []
     if settings.steps > 0 and scene.path_count > 0:
         optimizer = parameters.optimizer(settings)
-        indices = segment_indices(scene.offsets)
+        objective = _Objective(target_tensor, settings, segment_indices(scene.offsets))
         with single_torch_thread():
             for step in range(settings.steps):
                 optimizer.zero_grad(set_to_none=True)
-                rendered = parameters.render()
-                loss = torch.mean((rendered - target_tensor) ** 2)
-                if settings.xing_weight > 0:
-                    loss = loss + settings.xing_weight * xing_loss(
-                        parameters.points, indices=indices
-                    )
-                if settings.perceptual is not None and settings.perceptual_weight > 0:
-                    loss = loss + settings.perceptual_weight * settings.perceptual(rendered)
+                loss, reported = objective(parameters.render(), parameters.points, step)
                 loss.backward()
                 optimizer.step()
                 parameters.project(settings)
-                losses.append(float(loss.detach()))
+                losses.append(reported)
                 if on_step is not None:
-                    on_step(step, losses[-1])
+                    on_step(first_step + step, reported)
     return FitResult(parameters.fitted(), losses)
+
+
+class _Objective:
+    """MSE + λ_Xing · Xing + λ_LPIPS · LPIPS of a render.
+
+    With ``settings.perceptual_every`` k > 1, LPIPS and its gradient with respect to the render
+    are evaluated every k-th step only; the steps between add the linear term ⟨G, render⟩ with
+    the last gradient G, so every step still feels LPIPS while paying for it once in k (the
+    render changes little over a few steps). k = 1 is the exact objective.
+    """
+
+    def __init__(
+        self, target: torch.Tensor, settings: FitSettings, indices: tuple[torch.Tensor, ...]
+    ) -> None:
+        self.target = target
+        self.settings = settings
+        self.indices = indices
+        self.perceptual_gradient: torch.Tensor | None = None
+        self.perceptual_value = 0.0
+
+    def __call__(
+        self, rendered: torch.Tensor, points: torch.Tensor, step: int
+    ) -> tuple[torch.Tensor, float]:
+        """The loss to differentiate and the objective's value to report."""
+        settings = self.settings
+        loss = torch.mean((rendered - self.target) ** 2)
+        if settings.xing_weight > 0:
+            loss = loss + settings.xing_weight * xing_loss(points, indices=self.indices)
+        perceptual = settings.perceptual
+        if perceptual is None or settings.perceptual_weight <= 0:
+            return loss, float(loss.detach())
+        if settings.perceptual_every <= 1:
+            loss = loss + settings.perceptual_weight * perceptual(rendered)
+            return loss, float(loss.detach())
+        if step % settings.perceptual_every == 0 or self.perceptual_gradient is None:
+            image = rendered.detach().requires_grad_(True)
+            value = perceptual(image)
+            (gradient,) = torch.autograd.grad(value, image)
+            self.perceptual_gradient = gradient * settings.perceptual_weight
+            self.perceptual_value = settings.perceptual_weight * float(value.detach())
+        reported = float(loss.detach()) + self.perceptual_value
+        return loss + torch.sum(rendered * self.perceptual_gradient), reported

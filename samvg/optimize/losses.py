@@ -77,7 +77,7 @@ def lpips_loss(target: np.ndarray, size: int, weights: str | None = None) -> Per
 
     def prepare(image: torch.Tensor) -> torch.Tensor:
         batch = image.permute(2, 0, 1)[None]
-        if shape != (height, width):
+        if tuple(batch.shape[-2:]) != shape:
             batch = functional.interpolate(batch, size=shape, mode="bilinear", antialias=True)
         return batch
 

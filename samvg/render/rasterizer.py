@@ -46,9 +46,19 @@ def _check_size(width: int, height: int) -> tuple[int, int]:
     return width, height
 
 
-def _background(background: Sequence[float] | None) -> np.ndarray:
+def _background(
+    background: Sequence[float] | np.ndarray | None, width: int, height: int
+) -> np.ndarray:
+    """The opaque RGB (3,) behind the paths, or an (H, W, 3) image to paint them over."""
     if background is None:
         return np.ones(3, np.float64)
+    if isinstance(background, np.ndarray) and background.ndim == 3:
+        if background.shape != (height, width, 3) or not np.all(np.isfinite(background)):
+            raise InputError(
+                f"a background image must be finite with shape ({height}, {width}, 3), "
+                f"got {background.shape}"
+            )
+        return background
     try:
         bg = np.asarray(
             background.detach().cpu() if isinstance(background, torch.Tensor) else background,
@@ -236,6 +246,7 @@ class _Rasterize(torch.autograd.Function):
         out_dtype = np.float64 if flat_pts.dtype == torch.float64 else np.float32
         try:
             canvas = np.empty((height, width, 3), out_dtype)
+            canvas[...] = bg
             acc = np.empty(n_cells if keep else largest, np.float64)
             under = np.empty((n_cells if keep else 0, 3), np.float32)
         except MemoryError as exc:
@@ -244,7 +255,7 @@ class _Rasterize(torch.autograd.Function):
                 f"{width}x{height} canvas"
             ) from exc
         K.render_forward(
-            verts, vstart, box, off, cols, bg, canvas, acc, under, keep, kinds, stops, paint
+            verts, vstart, box, off, cols, canvas, acc, under, keep, kinds, stops, paint
         )
         ctx.col_dtype = colors.dtype
         ctx.paint_dtype = params.dtype
@@ -282,7 +293,7 @@ def rasterize(
     colors: torch.Tensor | np.ndarray,
     width: int,
     height: int,
-    background: Sequence[float] | None = (1.0, 1.0, 1.0),
+    background: Sequence[float] | np.ndarray | None = (1.0, 1.0, 1.0),
     *,
     offsets: np.ndarray | None = None,
     tolerance: float = FLATTEN_TOLERANCE,
@@ -298,7 +309,8 @@ def rasterize(
             ``points`` is the packed ``(N, 2)`` array of a `samvg.scene.Scene`.
         colors: ``(P, 4)`` straight RGBA in ``[0, 1]`` (used as given, not clamped).
         width, height: canvas size in pixels.
-        background: opaque RGB behind the paths; ``None`` means white.
+        background: opaque RGB behind the paths, ``None`` meaning white; or an
+            ``(height, width, 3)`` array, an image to paint the paths over.
         tolerance: maximum chord error (pixels) when flattening the cubics.
         gradients: linear and radial gradient paints (`GradientPaints`); a path whose kind is
             not flat takes its RGB from them (its alpha stays ``colors[p, 3]``).
@@ -314,7 +326,7 @@ def rasterize(
             non-positive or too large canvas.
     """
     width, height = _check_size(width, height)
-    bg = _background(background)
+    bg = _background(background, width, height)
     flat, starts = _flat_points(points, offsets)
     cols = _as_tensor(colors, "colors")
     n_paths = len(starts) - 1

@@ -75,3 +75,27 @@ def test_a_set_number_of_rounds_runs_exactly_that_many():
 def test_a_budget_pool_stops_growing_when_full():
     done = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), STAGES, pool=2)
     assert done.scene.path_count == 2 and "pool of 2 paths is full" in done.stopped
+
+
+def test_rounds_fit_only_what_they_add_then_the_whole_scene_once():
+    from dataclasses import replace
+
+    from samvg.scene import FlatPaint
+    from tests.paths import square
+
+    misplaced = Scene.from_paths(64, 64, [(square(4, 4, 20), FlatPaint(RED))], (1.0, 1.0, 1.0))
+    fit = FitSettings(steps=40)
+    steps: list[int] = []
+    one_round = (replace(settings(rounds=1), refit_scene=False), STAGES[1], fit)
+    done = add_missing_rounds(
+        misplaced, target(), SilentSegmenter(), one_round, on_step=lambda s, _: steps.append(s)
+    )
+    assert done.added >= 2 and steps.count(0) == 2  # the added paths' fit, then the scene's
+    assert not np.allclose(done.scene.points[:12], misplaced.points)  # moved in the final fit
+    assert np.mean((done.scene.render() - target()) ** 2) < 2e-3
+    refit = (settings(rounds=1), STAGES[1], fit)
+    steps.clear()
+    add_missing_rounds(
+        misplaced, target(), SilentSegmenter(), refit, on_step=lambda s, _: steps.append(s)
+    )
+    assert steps.count(0) == 1  # the paper's round fits the whole scene, once

@@ -71,3 +71,53 @@ def test_a_gradient_paint_is_fitted_with_the_geometry():
         after = np.mean((result.scene.render() - target) ** 2)
         assert after < before / 3
     assert after < before  # the radial one does what it can
+
+
+def test_reused_lpips_gradient_is_exact_where_evaluated_and_stale_between(lpips_weights):
+    import torch
+
+    from samvg.optimize.fit import _Objective
+    from samvg.optimize.losses import lpips_loss, segment_indices
+
+    rng = np.random.default_rng(0)
+    target = rng.random((40, 48, 3)).astype(np.float32)
+    perceptual = lpips_loss(target, 48, str(lpips_weights))
+    settings = FitSettings(perceptual=perceptual, perceptual_weight=0.5, perceptual_every=3)
+    points = torch.zeros((3, 2), requires_grad=True)
+    objective = _Objective(torch.from_numpy(target), settings, segment_indices(np.array([0, 3])))
+
+    def gradients(render: np.ndarray, step: int) -> tuple[torch.Tensor, float]:
+        image = torch.from_numpy(render).requires_grad_(True)
+        loss, reported = objective(image, points, step)
+        loss.backward()
+        return image.grad, reported
+
+    first = rng.random((40, 48, 3)).astype(np.float32)
+    image = torch.from_numpy(first).requires_grad_(True)
+    exact = torch.mean((image - torch.from_numpy(target)) ** 2) + 0.5 * perceptual(image)
+    exact.backward()
+    at_zero, reported = gradients(first, 0)
+    torch.testing.assert_close(at_zero, image.grad)
+    assert reported == pytest.approx(float(exact.detach()), rel=1e-5)
+    second = np.clip(first + 0.2, 0, 1)
+    stale, _ = gradients(second, 1)  # LPIPS's part is step 0's; the MSE part is this render's
+    mse_part = 2 * (torch.from_numpy(second) - torch.from_numpy(target)) / second.size
+    first_mse = 2 * (image.detach() - torch.from_numpy(target)) / first.size
+    torch.testing.assert_close(stale - mse_part, at_zero - first_mse)
+    fresh, _ = gradients(second, 3)
+    assert not torch.allclose(fresh, stale)
+
+
+def test_coarse_to_fine_fit_lands_on_the_full_canvas():
+    size = 160
+    target = scene_of([(square(60, 64, 60), (0.9, 0.2, 0.1, 1.0))], size=size).render()
+    start = scene_of([(square(40, 50, 50), (0.5, 0.5, 0.5, 1.0))], size=size)
+    settings = FitSettings(steps=160, coarse_fraction=0.5, bounds=(-4, -4, 164, 164))
+    result = fit_scene(start, target, settings)
+    assert (result.scene.width, result.scene.height) == (size, size)
+    assert len(result.losses) == 160
+    assert np.abs(result.scene.points[6] - (120, 124)).max() < 1.0
+    assert np.abs(result.scene.render() - target).mean() < 0.01
+    small = fit_scene(scene_of([(square(1, 1, 4), (0, 0, 0, 1))], size=16), np.ones((16, 16, 3)),
+                      FitSettings(steps=4, coarse_fraction=0.5))  # fmt: skip
+    assert len(small.losses) == 4  # too small to halve: all steps at full size

@@ -165,3 +165,19 @@ def test_low_precision_and_integer_inputs_render_in_float32():
         assert leaf.grad.dtype == dtype
     grid = torch.tensor([[[2, 2], [5, 2], [8, 2], [8, 8], [5, 8], [2, 8]]])
     assert rasterize(grid, COLORS3[:1], 10, 10).dtype == torch.float32
+
+
+def test_paths_are_painted_over_a_background_image():
+    rng = np.random.default_rng(3)
+    under = rng.random((12, 16, 3))
+    points = torch.tensor([[[2.0, 2.0], [6, 2], [10, 2], [10, 2], [10, 6], [10, 10],
+                            [10, 10], [6, 10], [2, 10], [2, 10], [2, 6], [2, 2]]])  # fmt: skip
+    colours = torch.tensor([[0.2, 0.9, 0.4, 0.5]], requires_grad=True)
+    image = rasterize(points, colours, 16, 12, background=under)
+    np.testing.assert_allclose(image[0, 0].detach().numpy(), under[0, 0], atol=1e-6)
+    inside = 0.5 * under[5, 5] + 0.5 * np.array([0.2, 0.9, 0.4])
+    np.testing.assert_allclose(image[5, 5].detach().numpy(), inside, atol=1e-6)
+    image.sum().backward()
+    assert colours.grad is not None and torch.isfinite(colours.grad).all()
+    with pytest.raises(InputError, match="background image"):
+        rasterize(points, colours, 16, 12, background=under[:5])

@@ -1,0 +1,202 @@
+"""Speed (issue 14): time per stage and quality of samvg's default and ``--fast`` presets, an
+older commit against the working tree, run alternately image by image on one machine state.
+
+    python benchmarks/bench_speed.py run --old 45a9978 --per-category 4
+    python benchmarks/bench_speed.py report --old 45a9978
+
+``run`` checks the old commit out in a temporary git worktree and, for each bench image and
+preset, runs the old code and then the new code in fresh subprocesses (so neither warms the
+other's caches), each on the machine as it is at that moment: the machine is noisy, so the
+report gives medians and the median of the per-image ratios. Every run is one JSON record under
+``benchmarks/results/speed/<label>/`` (a rerun skips what is there, so a long run resumes). MSE
+and LPIPS are measured by the working tree's code on both SVGs, rendered at the 512-px working
+size. The report goes to ``benchmarks/results/speed.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[1]
+RECORDS = REPO / "benchmarks/results/speed"
+REPORT = REPO / "benchmarks/results/speed.md"
+PRESETS = ("default", "fast")
+STAGES = ("segment", "trace", "optimize", "reshape", "missing", "refine", "reduce", "finish")
+
+
+def worker(image: str, preset: str) -> None:
+    """In the tree under test (first on ``PYTHONPATH``): vectorize one image and print a JSON
+    line with the timings, counts and SVG."""
+    import samvg
+
+    config = samvg.Config() if preset == "default" else samvg.Config.fast()
+    started = time.perf_counter()
+    result = samvg.run(image, config)
+    seconds = time.perf_counter() - started
+    record = {
+        "samvg": str(Path(samvg.__file__).resolve().parent),
+        "seconds": seconds,
+        "timings": result.timings,
+        "paths": result.counts.get("paths", 0),
+        "svg": result.image.to_svg(),
+    }
+    print(json.dumps(record))
+
+
+def run_tree(tree: Path, image: Path, preset: str) -> dict[str, Any]:
+    """One worker run on the code in ``tree``."""
+    environment = {**os.environ, "PYTHONPATH": str(tree)}
+    command = [sys.executable, str(Path(__file__).resolve()), "worker", str(image), preset]
+    done = subprocess.run(command, env=environment, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise SystemExit(f"worker failed on {image.name} in {tree}: {done.stderr[-2000:]}")
+    record = json.loads(done.stdout.strip().splitlines()[-1])
+    if Path(record["samvg"]) != (tree / "samvg").resolve():
+        raise SystemExit(f"the worker imported {record['samvg']}, not {tree / 'samvg'}")
+    return record
+
+
+def measure(record: dict[str, Any], image: Path, lpips: Any) -> dict[str, Any]:
+    """MSE and LPIPS of the record's SVG against the image at the 512-px working size."""
+    import numpy as np
+
+    from samvg import VectorImage
+    from samvg.imaging import resize_longest, to_float_rgb
+    from samvg.io import read_image
+    from samvg.metrics import lpips_distance
+
+    original = read_image(image)
+    working, scale = resize_longest(original, 512)
+    target = to_float_rgb(working)
+    vector = VectorImage.from_svg(record.pop("svg"))
+    picture = np.clip(vector.render(scale=scale), 0.0, 1.0)[: target.shape[0], : target.shape[1]]
+    record["mse"] = float(np.mean((picture - target) ** 2))
+    record["lpips"] = lpips_distance(lpips, picture, target)
+    return record
+
+
+def run_study(old: str, per_category: int, presets: list[str]) -> None:
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    from bench_images import BENCH, bench_entries
+
+    from samvg.io import atomic_write_text
+    from samvg.metrics import load_lpips
+
+    lpips = load_lpips()
+    with tempfile.TemporaryDirectory() as folder:
+        old_tree = Path(folder) / "old"
+        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(old_tree), old],
+                       check=True, capture_output=True)  # fmt: skip
+        try:
+            for entry in bench_entries(per_category):
+                for preset in presets:
+                    for label, tree in ((f"old-{old}", old_tree), ("new", REPO)):
+                        path = RECORDS / label / f"{entry['id']}.{preset}.json"
+                        if path.exists():
+                            continue
+                        image = BENCH / entry["png"]
+                        record = measure(run_tree(tree, image, preset), image, lpips)
+                        record.update(id=entry["id"], category=entry["category"], preset=preset)
+                        path.parent.mkdir(parents=True, exist_ok=True)
+                        atomic_write_text(path, json.dumps(record, indent=1))
+                        print(label, entry["id"], preset, f"{record['seconds']:.1f}s", flush=True)
+        finally:
+            subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force",
+                            str(old_tree)], check=False)  # fmt: skip
+
+
+def _records(label: str) -> dict[tuple[str, str], dict[str, Any]]:
+    found = {}
+    for path in sorted((RECORDS / label).glob("*.json")):
+        record = json.loads(path.read_text())
+        found[(record["id"], record["preset"])] = record
+    return found
+
+
+def _median(values: list[float]) -> str:
+    return f"{statistics.median(values):.2f}" if values else "–"
+
+
+def _stage_rows(old: dict, new: dict, keys: list, preset: str) -> list[str]:
+    rows = []
+    for stage in (*STAGES, "total"):
+        before = [old[k]["timings"].get(stage, 0.0) for k in keys]
+        after = [new[k]["timings"].get(stage, 0.0) for k in keys]
+        if not any(before) and not any(after):
+            continue
+        ratios = [b / a for b, a in zip(before, after, strict=True) if a > 0 and b > 0]
+        rows.append(f"| {preset} | {stage} | {_median(before)} | {_median(after)} | "
+                    f"{_median(ratios)}× |")  # fmt: skip
+    return rows
+
+
+def _quality_rows(old: dict, new: dict, keys: list, preset: str) -> list[str]:
+    rows = []
+    categories = sorted({old[k]["category"] for k in keys})
+    for category in [*categories, "all"]:
+        chosen = [k for k in keys if category in ("all", old[k]["category"])]
+        cells = []
+        for metric in ("mse", "lpips", "paths"):
+            before = statistics.mean(old[k][metric] for k in chosen)
+            after = statistics.mean(new[k][metric] for k in chosen)
+            scale = 1e3 if metric == "mse" else 1.0
+            cells.append(f"{before * scale:.3f} → {after * scale:.3f} ({after / before - 1:+.1%})")
+        rows.append(f"| {preset} | {category} | {len(chosen)} | " + " | ".join(cells) + " |")
+    return rows
+
+
+def write_report(old_label: str) -> None:
+    old, new = _records(f"old-{old_label}"), _records("new")
+    lines = [
+        "# Speed: per-stage time and quality, before and after (issue 14)",
+        "",
+        f"Old: commit `{old_label}`; new: the working tree when the records were made. Both run "
+        "alternately, image by image, in fresh processes on the same machine (2 cores), by "
+        "`python benchmarks/bench_speed.py run --old " + old_label + "`. Seconds are medians "
+        "over the images; the ratio is the median of the per-image old/new ratios.",
+        "",
+        "| preset | stage | old s | new s | speed-up |",
+        "|---|---|---|---|---|",
+    ]
+    quality = [
+        "",
+        "## Quality (means; MSE ×1e-3 at 512 px, LPIPS-alex)",
+        "",
+        "| preset | category | images | MSE | LPIPS | paths |",
+        "|---|---|---|---|---|---|",
+    ]
+    for preset in PRESETS:
+        keys = sorted(k for k in old if k in new and k[1] == preset)
+        if keys:
+            lines += _stage_rows(old, new, keys, preset)
+            quality += _quality_rows(old, new, keys, preset)
+    REPORT.write_text("\n".join(lines + quality) + "\n")
+    print(REPORT.read_text())
+
+
+def main() -> None:
+    if len(sys.argv) > 1 and sys.argv[1] == "worker":
+        worker(sys.argv[2], sys.argv[3])
+        return
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("study", choices=("run", "report"))
+    parser.add_argument("--old", required=True, help="the commit to compare with")
+    parser.add_argument("--per-category", type=int, default=4)
+    parser.add_argument("--presets", default="default,fast")
+    arguments = parser.parse_args()
+    if arguments.study == "run":
+        run_study(arguments.old, arguments.per_category, arguments.presets.split(","))
+    write_report(arguments.old)
+
+
+if __name__ == "__main__":
+    main()
