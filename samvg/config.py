@@ -143,7 +143,7 @@ class FitOptions:
     lpips_size: int = 128
     """LPIPS is computed on the render resized to this longest side (cost, not quality)."""
     lpips_weights: str | None = None
-    lpips_every: int = 4
+    lpips_every: int = 2
     """Evaluate LPIPS every this many steps; the steps between reuse its last gradient with
     respect to the render (1: every step, the paper)."""
     coarse_fraction: float = 0.5

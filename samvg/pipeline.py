@@ -251,12 +251,12 @@ def _run_stages(
             )
         result.counts.update(counts)
     stages = (missing, trace_settings, fit)
-    scene = _add_missing(scene, inputs, segmenter, stages, config, result, report)
+    scene, fitted = _add_missing(scene, inputs, segmenter, stages, config, result, report)
     budget = config.missing.paths
     if budget is not None and config.finish.finish_pass:
         scene = _finish_pass(scene, config, inputs, result, report)  # merges and hidden go first
     if budget is not None:
-        scene = _reduce(scene, inputs, fit, budget, result, report)
+        scene = _reduce(scene, inputs, fit, budget, result, report, fitted)
     if config.finish.finish_pass:
         scene = _finish_pass(scene, config, inputs, result, report)
     if budget is not None:
@@ -344,9 +344,10 @@ def _add_missing(
     config: Config,
     result: PipelineResult,
     report: ProgressCallback,
-) -> Scene:
+) -> tuple[Scene, bool]:
     """Stage 4: as many rounds as asked, as ``detail`` decides, or until a path budget's pool is
-    full; then, under a budget, the paths of least impact are removed and the rest fitted."""
+    full. Returns the scene and whether it was fitted as a whole after its last paths came
+    (under a budget it is not: the fit after the cut does it)."""
     budget = config.missing.paths
     pool = math.ceil(BUDGET_POOL * budget) if budget is not None else None
     planned = settings[0].rounds
@@ -361,6 +362,7 @@ def _add_missing(
         on_round=lambda count, _round: report("missing", min(count, total), total),
         alpha=inputs.alpha,
         on_step=_progress_of(report, "refine", settings[2].steps),
+        fit_at_end=budget is None,  # under a budget, the fit after the cut is the whole fit
     )
     report("missing", total, total)
     result.missing_map, result.missing_prompts = done.error_map, done.prompts
@@ -371,7 +373,7 @@ def _add_missing(
         result.timings[stage] = result.timings.get(stage, 0.0) + seconds
     if done.rounds:
         result.notes.append(f"stage 4: {done.rounds} rounds, {done.added} paths ({done.stopped})")
-    return done.scene
+    return done.scene, done.fitted
 
 
 def _reduce(
@@ -381,13 +383,16 @@ def _reduce(
     budget: int,
     result: PipelineResult,
     report: ProgressCallback,
+    fitted: bool = True,
 ) -> Scene:
-    """The scene cut to ``budget`` paths (those of least removal cost go) and fitted again."""
-    if scene.path_count <= budget:
+    """The scene cut to ``budget`` paths (those of least removal cost go) and fitted again (or
+    fitted for the first time as a whole, when it was not)."""
+    if scene.path_count <= budget and fitted:
         return scene
     with _timed(result, "reduce"):
-        scene, removed = reduce_paths(scene, inputs.target, budget)
-        result.counts["reduced"] = result.counts.get("reduced", 0) + removed
+        if scene.path_count > budget:
+            scene, removed = reduce_paths(scene, inputs.target, budget)
+            result.counts["reduced"] = result.counts.get("reduced", 0) + removed
         return fit_scene(scene, inputs.target, fit, _progress_of(report, "reduce", fit.steps)).scene
 
 

@@ -101,8 +101,9 @@ def missing_masks(
         below=False,
     )
     if settings.colour_split is not None:
-        offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact, False)
-        offer_wrong_regions(canvas, render, settings.pixel_error, settings.colour_split)
+        lab = lab_image(target)
+        offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact, False, lab)
+        offer_wrong_regions(canvas, render, settings.pixel_error, settings.colour_split, lab)
     masks = canvas.kept_masks
     if limit is not None and len(masks) > limit:
         order = np.argsort(-np.asarray(canvas.impacts), kind="stable")[:limit]
@@ -111,14 +112,19 @@ def missing_masks(
 
 
 def offer_wrong_regions(
-    canvas: ImpactCanvas, render: np.ndarray, pixel_error: float, split: ColourSplitSettings
+    canvas: ImpactCanvas,
+    render: np.ndarray,
+    pixel_error: float,
+    split: ColourSplitSettings,
+    lab: np.ndarray | None = None,
 ) -> int:
     """Offer ``canvas`` the colour-coherent regions of the pixels ``render`` gets wrong (text,
-    stripes, small marks SAM's prompts missed), largest first; returns how many were kept."""
+    stripes, small marks SAM's prompts missed), largest first; returns how many were kept.
+    ``lab``: the target in CIELAB, when the caller has it already."""
     wrong = error_map(canvas.target, render) >= pixel_error
     if np.count_nonzero(wrong) < split.min_pixels:
         return 0
-    regions = colour_regions(wrong, lab_image(canvas.target), split)
+    regions = colour_regions(wrong, lab_image(canvas.target) if lab is None else lab, split)
     regions.sort(key=lambda region: -int(np.count_nonzero(region)))
     return sum(canvas.offer(region).kept for region in regions)
 
@@ -139,12 +145,14 @@ def add_missing(
     fit: FitSettings,
     on_step: StepCallback | None = None,
     alpha: np.ndarray | None = None,
+    render: np.ndarray | None = None,
 ) -> MissingRound:
     """One round of stage 4 on ``scene`` (working pixels) against ``target``; it adds no more
     paths than ``settings.max_paths`` leaves room for (none, without asking SAM, when full),
-    and none where the input is transparent (``alpha`` below 0.5)."""
+    and none where the input is transparent (``alpha`` below 0.5). ``render``: the scene's
+    render, when the caller has it already."""
     clock = time.perf_counter()
-    render = scene.render()
+    render = scene.render() if render is None else render
     averaged, above = missing_component_map(target, render, settings.radius, settings.threshold)
     prompts = missing_component_prompts(averaged, above)
     room = room_left(scene, settings)
@@ -159,7 +167,8 @@ def add_missing(
         if settings.refit_scene:
             result.scene = fit_scene(scene.stacked(added), target, fit, on_step).scene
         else:
-            result.scene = scene.stacked(fit_scene(added, target, fit, on_step, render).scene)
+            alone = replace(fit, perceptual=None, perceptual_weight=0.0)  # LPIPS comes at the end
+            result.scene = scene.stacked(fit_scene(added, target, alone, on_step, render).scene)
         result.timings["refine"] = time.perf_counter() - clock
     return result
 
@@ -177,6 +186,8 @@ class MissingRounds:
     prompt_count: int = 0
     timings: dict[str, float] = field(default_factory=dict)
     stopped: str = ""
+    fitted: bool = True
+    """Whether the scene was fitted as a whole after its last paths were added."""
 
 
 def add_missing_rounds(
@@ -188,26 +199,29 @@ def add_missing_rounds(
     on_round: Callable[[int, MissingRound], None] | None = None,
     alpha: np.ndarray | None = None,
     on_step: StepCallback | None = None,
+    fit_at_end: bool = True,
 ) -> MissingRounds:
     """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
     less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`). With a ``pool`` (a path
     budget), rounds take the candidates of largest impact, however small, until the scene has
     ``pool`` paths or a round finds nothing more (at most ``2 * MAX_AUTO_ROUNDS``). Unless
     ``settings.refit_scene``, rounds fit only the paths they add and the whole scene is fitted
-    once at the end."""
+    once at the end (with ``fit_at_end``; else ``fitted`` is False and the caller fits it)."""
     settings, trace, fit = stages
+    full_at = None
     if pool is not None:
-        limit = pool if settings.max_paths is None else min(pool, settings.max_paths)
-        settings = replace(settings, impact_threshold=0.0, max_paths=limit)
+        full_at = pool if settings.max_paths is None else min(pool, settings.max_paths)
+        settings = replace(settings, impact_threshold=0.0, max_paths=full_at)
     planned = settings.rounds
     most = planned if planned is not None else MAX_AUTO_ROUNDS * (2 if pool else 1)
     done = MissingRounds(scene)
-    error = _mse(scene, target)
+    render = scene.render()
+    error = _mse(render, target)
     while done.rounds < most:
-        if pool is not None and scene.path_count >= (settings.max_paths or pool):
+        if full_at is not None and scene.path_count >= full_at:
             done.stopped = f"the pool of {pool} paths is full"
             break
-        round_ = add_missing(scene, target, segmenter, settings, trace, fit, on_step, alpha)
+        round_ = add_missing(scene, target, segmenter, settings, trace, fit, on_step, alpha, render)
         done.rounds += 1
         done.added += round_.added
         done.prompt_count += len(round_.prompts)
@@ -217,7 +231,8 @@ def add_missing_rounds(
         if on_round is not None:
             on_round(done.rounds, round_)
         scene = round_.scene
-        now = _mse(scene, target)
+        render = scene.render()
+        now = _mse(render, target)
         gain = (error - now) / max(error, 1e-12)
         error = now
         if round_.added == 0:
@@ -226,14 +241,16 @@ def add_missing_rounds(
         if planned is None and pool is None and gain < settings.gain_tolerance:
             done.stopped = f"round {done.rounds} lowered the error by {gain:.1%}"
             break
-    if done.added and not settings.refit_scene:
+    done.fitted = settings.refit_scene or not done.added
+    if not done.fitted and fit_at_end:
         clock = time.perf_counter()
         scene = fit_scene(scene, target, fit, on_step).scene
         done.timings["refine"] = done.timings.get("refine", 0.0) + time.perf_counter() - clock
+        done.fitted = True
     done.scene = scene
     done.stopped = done.stopped or f"{done.rounds} rounds"
     return done
 
 
-def _mse(scene: Scene, target: np.ndarray) -> float:
-    return float(np.mean((scene.render() - target) ** 2))
+def _mse(render: np.ndarray, target: np.ndarray) -> float:
+    return float(np.mean((render - target) ** 2))

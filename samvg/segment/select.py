@@ -114,11 +114,13 @@ def offer_colour_parts(
     settings: ColourSplitSettings,
     use_filter: bool = True,
     include_uncovered: bool = True,
+    lab: np.ndarray | None = None,
 ) -> int:
     """Split every mask kept on ``canvas`` (and, with ``include_uncovered``, the pixels no mask
     covers, which the background fills) into colour-coherent parts and offer the parts to the
-    canvas, largest first; returns how many were kept."""
-    lab = lab_image(canvas.target)
+    canvas, largest first; returns how many were kept. ``lab``: the target in CIELAB, when the
+    caller has it already."""
+    lab = lab_image(canvas.target) if lab is None else lab
     regions = list(canvas.kept_masks)
     if include_uncovered and not canvas.covered.all():
         regions.append(~canvas.covered)
