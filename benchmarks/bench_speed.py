@@ -10,7 +10,9 @@ other's caches), each on the machine as it is at that moment: the machine is noi
 report gives medians and the median of the per-image ratios. Every run is one JSON record under
 ``benchmarks/results/speed/<label>/`` (a rerun skips what is there, so a long run resumes). MSE
 and LPIPS are measured by the working tree's code on both SVGs, rendered at the 512-px working
-size. The report goes to ``benchmarks/results/speed.md``.
+size. The report goes to ``benchmarks/results/speed.md``, with a plot of time against path
+count (``speed_paths.png``) for samvg, random init (diffvg) and the LIVE-style baseline at fixed
+budgets, drawn from the records of ``bench_detail.py budget`` (which time every run).
 """
 
 from __future__ import annotations
@@ -29,6 +31,9 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 RECORDS = REPO / "benchmarks/results/speed"
 REPORT = REPO / "benchmarks/results/speed.md"
+PLOT = REPO / "benchmarks/results/speed_paths.png"
+DETAIL = REPO / "benchmarks/results/detail"
+PLOTTED = ("samvg", "samvg-gradients", "diffvg", "live")
 PRESETS = ("default", "fast")
 STAGES = ("segment", "trace", "optimize", "reshape", "missing", "refine", "reduce", "finish")
 
@@ -179,8 +184,52 @@ def write_report(old_label: str) -> None:
         if keys:
             lines += _stage_rows(old, new, keys, preset)
             quality += _quality_rows(old, new, keys, preset)
-    REPORT.write_text("\n".join(lines + quality) + "\n")
+    REPORT.write_text("\n".join(lines + quality + _paths_section()) + "\n")
     print(REPORT.read_text())
+
+
+def _budget_seconds() -> dict[str, dict[int, list[float]]]:
+    """Seconds of every budget run of ``bench_detail.py``, by method and path budget."""
+    seconds: dict[str, dict[int, list[float]]] = {}
+    for path in sorted(DETAIL.glob("*.json")):
+        record = json.loads(path.read_text())
+        if record.get("study") == "budget" and record["method"] in PLOTTED:
+            by_budget = seconds.setdefault(record["method"], {})
+            by_budget.setdefault(int(record["budget"]), []).append(float(record["seconds"]))
+    return seconds
+
+
+def _paths_section() -> list[str]:
+    """The time-against-paths table and plot (medians over the images run at each budget)."""
+    seconds = _budget_seconds()
+    if not seconds:
+        return []
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    lines = [
+        "",
+        "## Time against path count (median seconds per image, `bench_detail.py budget`)",
+        "",
+        "| method | paths | images | median s |",
+        "|---|---|---|---|",
+    ]
+    figure, axes = plt.subplots(figsize=(6, 4))
+    for method, by_budget in sorted(seconds.items()):
+        budgets = sorted(by_budget)
+        medians = [statistics.median(by_budget[n]) for n in budgets]
+        axes.plot(budgets, medians, marker="o", label=method)
+        lines += [
+            f"| {method} | {n} | {len(by_budget[n])} | {m:.1f} |"
+            for n, m in zip(budgets, medians, strict=True)
+        ]
+    axes.set(xscale="log", yscale="log", xlabel="paths", ylabel="seconds per image (median)")
+    axes.legend()
+    figure.tight_layout()
+    figure.savefig(PLOT, dpi=100)
+    return [*lines, "", f"![time against paths]({PLOT.name})"]
 
 
 def main() -> None:

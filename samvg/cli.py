@@ -156,8 +156,8 @@ def _config(arguments: argparse.Namespace) -> Config:
         settings["filter_by_impact"] = False
     if arguments.translucent:
         settings["translucent"] = True
-    if arguments.gradients:
-        settings["gradients"] = True
+    if arguments.gradients is not None:
+        settings["gradients"] = arguments.gradients
     if arguments.no_finish:
         settings["finish_pass"] = False
     preset = "fast" if arguments.fast else arguments.preset
@@ -433,8 +433,9 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
     )
     vectorize.add_argument(
         "--gradients",
-        action="store_true",
-        help="let paths take linear or radial gradient fills where they pay for their parameters",
+        action=argparse.BooleanOptionalAction,
+        help="let paths take linear or radial gradient fills where they pay for their parameters "
+        "(--no-gradients keeps every fill flat)",
     )
     vectorize.add_argument(
         "--no-finish",

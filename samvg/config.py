@@ -149,6 +149,9 @@ class FitOptions:
     coarse_fraction: float = 0.5
     """The share of each phase's steps fitted first at half size, coarse to fine (0: none, the
     paper)."""
+    plateau_steps: int | None = None
+    """Stop a phase early once its loss improved by less than 0.1 % over this many steps
+    (None: every phase runs all its steps, the paper)."""
     translucent: bool = False
     """Learn each fill's opacity (the paper does); off keeps every fill opaque, except on
     inputs with an alpha channel."""
@@ -167,6 +170,8 @@ class FitOptions:
         _check_integer(self, "lpips_size", 32)
         _check_integer(self, "lpips_every", 1)
         _check_non_negative(self, "coarse_fraction")
+        if self.plateau_steps is not None:
+            _check_integer(self, "plateau_steps", 1)
         if self.coarse_fraction > 1:
             raise InputError(f"coarse fraction must be from 0 to 1, got {self.coarse_fraction!r}")
         for name in (

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from samvg import VectorImage
+from samvg import Config, VectorImage
 from samvg.cli import main
 from samvg.io import read_image
 
@@ -218,3 +218,15 @@ def test_several_line_messages_are_joined_into_one():
     assert one_line(message) == (
         "could not find x. Tried: cache: not found; download: failed; To fix: put it"
     )
+
+
+def test_gradient_fills_can_be_asked_for_or_refused():
+    from samvg.cli import _config, build_parser
+
+    def config(*options: str):
+        return _config(build_parser().parse_args(["vectorize", "in.png", "-o", "o.svg", *options]))
+
+    assert config("--gradients").fit.gradients is True
+    assert config("--no-gradients").fit.gradients is False
+    assert config().fit.gradients == Config().fit.gradients
+    assert config("--preset", "paper", "--gradients").fit.gradients is True

@@ -20,6 +20,11 @@ from samvg.render._paint_kernels import MAX_STOPS, RADIAL
 from samvg.render.rasterizer import GradientPaints
 from samvg.scene import Scene
 
+#: A phase with ``plateau_steps`` set stops when its best loss improved by less than this
+#: fraction over the last ``plateau_steps`` steps.
+PLATEAU_GAIN = 1e-3
+#: ... or by less than this much loss (a fit that is already exact).
+PLATEAU_FLOOR = 1e-7
 #: Canvases whose longer side is below this are fitted at full size only.
 COARSE_MIN_SIDE = 128
 _DIVERGED = "optimization diverged (non-finite coordinates); try a lower learning rate"
@@ -50,6 +55,9 @@ class FitSettings:
     """Evaluate LPIPS every this many steps and reuse its gradient in between (1: every step)."""
     coarse_fraction: float = 0.0
     """The share of the steps fitted first at half size (0: all at full size)."""
+    plateau_steps: int | None = None
+    """Stop a phase (each size of it) once its loss has stopped improving over this many steps
+    (None: always run every step)."""
     gradient_cost: float | None = None
     """Offer every flat path a gradient fill before fitting (`samvg.optimize.paint_choice`),
     bought when it removes this much MSE per added parameter; None: fills stay as they are."""
@@ -83,6 +91,7 @@ class FitSettings:
             bounds=bounds,
             perceptual_every=options.lpips_every,
             coarse_fraction=options.coarse_fraction,
+            plateau_steps=options.plateau_steps,
             gradient_cost=options.gradient_cost if options.gradients else None,
         )
 
@@ -301,7 +310,20 @@ def _fit_level(
                 losses.append(reported)
                 if on_step is not None:
                     on_step(first_step + step, reported)
+                if _plateaued(losses, settings.plateau_steps):
+                    if on_step is not None:
+                        on_step(first_step + settings.steps - 1, reported)
+                    break
     return FitResult(parameters.fitted(), losses)
+
+
+def _plateaued(losses: list[float], window: int | None) -> bool:
+    """Whether the best loss of the last ``window`` steps is within `PLATEAU_GAIN` (relative) or
+    `PLATEAU_FLOOR` (absolute) of the best before them (None: never)."""
+    if window is None or len(losses) < 2 * window:
+        return False
+    before = min(losses[:-window])
+    return before - min(losses[-window:]) < PLATEAU_GAIN * before + PLATEAU_FLOOR
 
 
 class _Objective:

@@ -121,3 +121,15 @@ def test_coarse_to_fine_fit_lands_on_the_full_canvas():
     small = fit_scene(scene_of([(square(1, 1, 4), (0, 0, 0, 1))], size=16), np.ones((16, 16, 3)),
                       FitSettings(steps=4, coarse_fraction=0.5))  # fmt: skip
     assert len(small.losses) == 4  # too small to halve: all steps at full size
+
+
+def test_a_fit_stops_once_its_loss_stops_improving():
+    target = scene_of([(square(20, 24, 24), (0.9, 0.2, 0.1, 1.0))]).render()
+    start = scene_of([(square(14, 18, 20), (0.5, 0.5, 0.5, 1.0))])
+    steps: list[int] = []
+    result = fit_scene(
+        start, target, FitSettings(steps=600, plateau_steps=25), lambda s, _: steps.append(s)
+    )
+    assert 50 <= len(result.losses) < 600 and steps[-1] == 599  # progress completes
+    assert np.abs(result.scene.render() - target).mean() < 0.01
+    assert len(fit_scene(start, target, FitSettings(steps=60)).losses) == 60
