@@ -112,20 +112,27 @@ def save(name: str, entry: dict[str, str], extra: dict[str, Any], make: Any, *ar
     print(json.dumps(record), flush=True)
 
 
-def run_budget(entries: list[dict[str, str]], budgets: list[int], methods: list[str]) -> None:
+def run_budget(
+    entries: list[dict[str, str]],
+    budgets: list[int],
+    methods: list[str],
+    overrides: dict[str, Any],
+) -> None:
     lpips = load_lpips()
     for budget in budgets:
         for entry in entries:
             for method in methods:
                 extra = {"study": "budget", "method": method, "budget": budget}
                 if method in ("samvg", "samvg-gradients"):
-                    config = samvg.Config(paths=budget, gradients=method == "samvg-gradients")
+                    gradients = method == "samvg-gradients"
+                    config = samvg.Config(paths=budget, gradients=gradients, **overrides)
+                    extra["overrides"] = overrides
                     save(f"{method}.{budget}", entry, extra, samvg_record, config, lpips)
                 else:
                     save(f"{method}.{budget}", entry, extra, baseline_record, method, budget, lpips)
 
 
-def run_rate(entries: list[dict[str, str]], budgets: list[int]) -> None:
+def run_rate(entries: list[dict[str, str]], budgets: list[int], overrides: dict[str, Any]) -> None:
     lpips = load_lpips()
     for entry in entries:
         for setting in VTRACER_SWEEP:
@@ -135,7 +142,9 @@ def run_rate(entries: list[dict[str, str]], budgets: list[int]) -> None:
         for budget in budgets:
             for method in ("samvg", "samvg-gradients"):
                 extra = {"study": "rate", "method": method, "setting": str(budget)}
-                config = samvg.Config(paths=budget, gradients=method == "samvg-gradients")
+                extra["overrides"] = overrides
+                gradients = method == "samvg-gradients"
+                config = samvg.Config(paths=budget, gradients=gradients, **overrides)
                 save(f"rate.{method}.{budget}", entry, extra, samvg_record, config, lpips)
 
 
@@ -146,7 +155,15 @@ def main() -> None:
     parser.add_argument("--categories", help="comma-separated (default: all six)")
     parser.add_argument("--paths", default="16,64", help="budgets, comma-separated")
     parser.add_argument("--methods", default="samvg,samvg-gradients,vtracer,live,diffvg")
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a samvg setting for every samvg run (kept in each record), e.g. plateau_steps=50",
+    )
     arguments = parser.parse_args()
+    overrides = dict(_setting(text) for text in arguments.set)
     if arguments.study == "report":
         from detail_report import write_report
 
@@ -158,9 +175,18 @@ def main() -> None:
     entries = bench_entries(arguments.per_category, categories)
     budgets = [int(text) for text in arguments.paths.split(",")]
     if arguments.study == "budget":
-        run_budget(entries, budgets, arguments.methods.split(","))
+        run_budget(entries, budgets, arguments.methods.split(","), overrides)
     else:
-        run_rate(entries, budgets)
+        run_rate(entries, budgets, overrides)
+
+
+def _setting(text: str) -> tuple[str, Any]:
+    """``name=value`` with the value read as JSON where it parses (numbers, true, null)."""
+    name, _, value = text.partition("=")
+    try:
+        return name, json.loads(value)
+    except json.JSONDecodeError:
+        return name, value
 
 
 if __name__ == "__main__":

@@ -143,15 +143,15 @@ class FitOptions:
     lpips_size: int = 128
     """LPIPS is computed on the render resized to this longest side (cost, not quality)."""
     lpips_weights: str | None = None
-    lpips_every: int = 2
+    lpips_every: int = 1
     """Evaluate LPIPS every this many steps; the steps between reuse its last gradient with
-    respect to the render (1: every step, the paper)."""
-    coarse_fraction: float = 0.5
+    respect to the render (1: every step, the paper and the default)."""
+    coarse_fraction: float = 0.0
     """The share of each phase's steps fitted first at half size, coarse to fine (0: none, the
-    paper)."""
+    paper and the default)."""
     plateau_steps: int | None = None
     """Stop a phase early once its loss improved by less than 0.1 % over this many steps
-    (None: every phase runs all its steps, the paper)."""
+    (None: every phase runs all its steps, the paper and the default)."""
     translucent: bool = False
     """Learn each fill's opacity (the paper does); off keeps every fill opaque, except on
     inputs with an alpha channel."""
@@ -219,10 +219,10 @@ class MissingOptions:
     paths: int | None = None
     """Exactly this many paths when the image holds that much detail: stage 4 grows the scene to
     a larger pool, then the paths of least impact are removed (None: as ``detail`` decides)."""
-    refit_scene: bool = False
-    """Fit the whole scene again after every stage-4 round (the paper). Off, a round fits only
-    the paths it adds, over a fixed render of the rest, and the whole scene is fitted once after
-    the last round."""
+    refit_scene: bool = True
+    """Fit the whole scene again after every stage-4 round (the paper and the default). Off, a
+    round fits only the paths it adds (MSE + Xing), over a fixed render of the rest, and the
+    whole scene is fitted once after the last round."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015
@@ -382,9 +382,6 @@ PAPER: dict[str, Any] = {
     "finish_pass": False,
     "colour_split": False,
     "missing_rounds": 1,
-    "refit_scene": True,
-    "lpips_every": 1,
-    "coarse_fraction": 0.0,
 }
 #: How `Config.fast` differs from the default.
 FAST: dict[str, Any] = {"points_per_side": 16, "size": 384, "iterations": 120, "use_lpips": False}

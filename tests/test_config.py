@@ -91,7 +91,7 @@ def test_detail_and_paths_are_checked_and_the_paper_runs_one_round():
 
 
 def test_speed_settings_are_checked_and_the_paper_fits_exactly():
-    assert Config().fit.lpips_every > 1 and Config().fit.coarse_fraction > 0
+    assert Config().fit.lpips_every == 1 and Config().fit.coarse_fraction == 0
     assert Config.paper().fit.lpips_every == 1 and Config.paper().fit.coarse_fraction == 0
     for bad in ({"lpips_every": 0}, {"coarse_fraction": 1.5}, {"coarse_fraction": -0.1}):
         with pytest.raises(InputError, match="lpips every|coarse fraction"):

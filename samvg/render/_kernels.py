@@ -318,11 +318,12 @@ def _path_deposits(
 @njit(cache=True, nogil=True)
 def render_forward(
     verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray, off: np.ndarray,
-    colors: np.ndarray, canvas: np.ndarray, acc: np.ndarray,
+    colors: np.ndarray, background: np.ndarray, canvas: np.ndarray, acc: np.ndarray,
     under: np.ndarray, keep: bool, kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
 ) -> None:  # fmt: skip
-    """Coverage and straight-alpha "over" compositing, path by path in paint order, onto
-    ``canvas`` as given (filled with the background by the caller).
+    """Coverage and straight-alpha "over" compositing, path by path in paint order, over the
+    opaque RGB ``background`` (3,); an empty ``background`` (0,) paints over ``canvas`` as
+    given (an image the caller filled it with).
 
     A path whose ``kinds`` entry is not ``FLAT`` takes its RGB per pixel from its gradient paint
     (``samvg.render._paint_kernels``); its alpha is still ``colors[p, 3]``.
@@ -331,6 +332,11 @@ def render_forward(
     of every box pixel stays in ``acc`` at ``off[p]`` and the colour under it in ``under`` (for the
     backward pass); without, ``acc`` is a scratch buffer of the largest box and ``under`` unused.
     """
+    if background.shape[0] == 3:
+        for y in range(canvas.shape[0]):
+            for x in range(canvas.shape[1]):
+                for ch in range(3):
+                    canvas[y, x, ch] = background[ch]
     n_paths = box.shape[0]
     for p in range(n_paths):
         bw = box[p, 2]

@@ -46,6 +46,10 @@ def _check_size(width: int, height: int) -> tuple[int, int]:
     return width, height
 
 
+_NO_BACKGROUND = np.zeros(0, np.float64)
+"""Tells the forward kernel the canvas already holds the background image."""
+
+
 def _background(
     background: Sequence[float] | np.ndarray | None, width: int, height: int
 ) -> np.ndarray:
@@ -246,7 +250,8 @@ class _Rasterize(torch.autograd.Function):
         out_dtype = np.float64 if flat_pts.dtype == torch.float64 else np.float32
         try:
             canvas = np.empty((height, width, 3), out_dtype)
-            canvas[...] = bg
+            if bg.ndim == 3:
+                canvas[...] = bg
             acc = np.empty(n_cells if keep else largest, np.float64)
             under = np.empty((n_cells if keep else 0, 3), np.float32)
         except MemoryError as exc:
@@ -255,7 +260,19 @@ class _Rasterize(torch.autograd.Function):
                 f"{width}x{height} canvas"
             ) from exc
         K.render_forward(
-            verts, vstart, box, off, cols, canvas, acc, under, keep, kinds, stops, paint
+            verts,
+            vstart,
+            box,
+            off,
+            cols,
+            bg if bg.ndim == 1 else _NO_BACKGROUND,
+            canvas,
+            acc,
+            under,
+            keep,
+            kinds,
+            stops,
+            paint,
         )
         ctx.col_dtype = colors.dtype
         ctx.paint_dtype = params.dtype
