@@ -20,6 +20,7 @@ import argparse
 import io
 import json
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -56,9 +57,17 @@ def measured(picture: np.ndarray, target: np.ndarray, lpips: Any) -> dict[str, f
     }
 
 
+#: Where samvg's SVGs are also written (``--keep-svg``), for a contact sheet without reruns.
+KEEP_SVG: list[Path] = []
+
+
 def samvg_record(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dict[str, Any]:
     run = run_samvg(entry, config)
     svg = run.result.image.to_svg()
+    for folder in KEEP_SVG:
+        folder.mkdir(parents=True, exist_ok=True)
+        tag = f"{config.missing.paths}.{'gradients' if config.fit.gradients else 'flat'}"
+        atomic_write_text(folder / f"{entry['id']}.{tag}.svg", svg)
     return {
         "paths": run.result.counts.get("paths", 0),
         "svg_bytes": len(svg.encode()),
@@ -162,7 +171,10 @@ def main() -> None:
         metavar="NAME=VALUE",
         help="a samvg setting for every samvg run (kept in each record), e.g. plateau_steps=50",
     )
+    parser.add_argument("--keep-svg", type=Path, help="also write samvg's SVGs to this folder")
     arguments = parser.parse_args()
+    if arguments.keep_svg is not None:
+        KEEP_SVG.append(arguments.keep_svg)
     overrides = dict(_setting(text) for text in arguments.set)
     if arguments.study == "report":
         from detail_report import write_report

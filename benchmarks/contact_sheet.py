@@ -3,6 +3,10 @@ N paths], one row per bench image, with path counts, MSE and SVG bytes under eac
 
     python benchmarks/contact_sheet.py --per-category 2 --preset fast --output sheet.png
     python benchmarks/contact_sheet.py --per-category 2 --preset default --budget 64 --output s.png
+    python benchmarks/contact_sheet.py --svg-dir svgs/ --categories digital_art --output g.png
+
+``--svg-dir`` draws SVGs written earlier (``bench_detail.py --keep-svg``) instead of running
+samvg: one column per ``<id>.<tag>.svg`` file of the image, in name order, then VTracer's.
 
 Photos and paintings may be drawn for a local look (``--categories photo,painting``), but their
 sheets must not be committed (the bench's licences forbid copies of them in the repository).
@@ -15,11 +19,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from bench_images import REPO, bench_entries, run_samvg, vtracer_default
+from bench_images import BENCH, REPO, bench_entries, run_samvg, vtracer_default
 from PIL import Image, ImageDraw
 
 import samvg
 from samvg.baselines import render_svg
+from samvg.imaging import resize_longest, to_float_rgb
+from samvg.io import read_image
 
 CELL = 256
 CAPTION = 30
@@ -71,6 +77,30 @@ def row_for(
     return row
 
 
+def row_from_svgs(entry: dict[str, str], folder: Path) -> list[Image.Image]:
+    """Target | every saved SVG of the image | VTracer's default, with paths, MSE and bytes."""
+    from samvg import VectorImage
+
+    working = resize_longest(read_image(BENCH / entry["png"]), 512)[0]
+    target = to_float_rgb(working)
+    height, width = target.shape[:2]
+    row = [cell(target, entry["id"][:36])]
+    for path in sorted(folder.glob(f"{entry['id']}.*.svg")):
+        svg = path.read_text()
+        image = VectorImage.from_svg(svg)
+        picture = np.clip(image.render(scale=width / image.width), 0, 1)[:height, :width]
+        error = float(np.mean((picture - target) ** 2))
+        tag = path.name[len(entry["id"]) + 1 : -4]
+        row.append(cell(picture, f"{tag}: {len(image.paths)}p {error * 1e3:.2f}e-3 "
+                                 f"{len(svg.encode()) / 1e3:.1f}kB"))  # fmt: skip
+    svg = vtracer_default(working)
+    theirs = render_svg(svg, width, height)
+    error = float(np.mean((theirs - target) ** 2))
+    row.append(cell(theirs, f"vtracer {svg.count('<path')}p {error * 1e3:.2f}e-3 "
+                            f"{len(svg) / 1e3:.0f}kB"))  # fmt: skip
+    return row
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-category", type=int, default=2)
@@ -78,14 +108,20 @@ def main() -> None:
     parser.add_argument("--preset", choices=sorted(PRESETS), default="fast")
     parser.add_argument("--output", type=Path, required=True)
     parser.add_argument("--budget", type=int, help="add a column: samvg with --paths N")
+    parser.add_argument("--svg-dir", type=Path, help="draw saved SVGs instead of running samvg")
     arguments = parser.parse_args()
     wanted = arguments.categories.split(",")
     if arguments.output.resolve().is_relative_to(REPO) and {"photo", "painting"} & set(wanted):
         sys.exit("photo and painting sheets stay out of the repository: write them elsewhere")
     config = PRESETS[arguments.preset]()
     entries = bench_entries(arguments.per_category, wanted)
-    rows = [row_for(entry, config, arguments.budget) for entry in entries]
-    sheet = Image.new("RGB", (len(rows[0]) * CELL, len(rows) * (CELL + CAPTION)), "white")
+    if arguments.svg_dir is not None:
+        entries = [e for e in entries if any(arguments.svg_dir.glob(f"{e['id']}.*.svg"))]
+        rows = [row_from_svgs(entry, arguments.svg_dir) for entry in entries]
+    else:
+        rows = [row_for(entry, config, arguments.budget) for entry in entries]
+    width = max(len(row) for row in rows)
+    sheet = Image.new("RGB", (width * CELL, len(rows) * (CELL + CAPTION)), "white")
     for index, row in enumerate(rows):
         for column, picture in enumerate(row):
             sheet.paste(picture, (column * CELL, index * (CELL + CAPTION)))

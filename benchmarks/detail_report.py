@@ -145,7 +145,8 @@ def gradient_table(records: list[dict[str, Any]]) -> list[str]:
         "## Gradient fills against flat fills at equal budgets (issue 13)",
         "",
         "`samvg --paths N --gradients` against `samvg --paths N`, same images. *better* = "
-        "images where gradients give lower MSE **and** lower LPIPS.",
+        "images where gradients give lower MSE **and** lower LPIPS. "
+        + _settings_note([r for _, p in complete for r in p.values()]),
         "",
         "| N | category | images | flat MSE ×1e-3 | gradients MSE ×1e-3 | flat LPIPS | "
         "gradients LPIPS | flat bytes | gradients bytes | better |",
@@ -175,6 +176,18 @@ def gradient_table(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+def _settings_note(rows: list[dict[str, Any]]) -> str:
+    """Which samvg settings the runs used besides the default (``bench_detail.py --set``)."""
+    found = sorted({json.dumps(row.get("overrides") or {}, sort_keys=True) for row in rows})
+    if found == ["{}"]:
+        return "Default settings."
+    return (
+        "Settings besides the default, the same for both: "
+        + "; ".join(f"`{text}`" for text in found)
+        + "."
+    )
+
+
 def rate_plot(records: list[dict[str, Any]]) -> list[str]:
     """Mean MSE and LPIPS against mean SVG bytes for photos and paintings, per setting."""
     import matplotlib
@@ -189,7 +202,11 @@ def rate_plot(records: list[dict[str, Any]]) -> list[str]:
     for row in rows:
         curves[row["method"]][row["setting"]].append(row)
     figure, axes = plt.subplots(1, 2, figsize=(10, 4))
-    lines = ["", "## Rate-distortion, photos and paintings", "", f"![rate]({PLOT.name})", ""]
+    lines = ["", "## Rate-distortion, photos and paintings", ""]
+    samvg_rows = [r for r in rows if r["method"] != "vtracer"]
+    if samvg_rows:
+        lines += ["samvg at `--paths N`. " + _settings_note(samvg_rows), ""]
+    lines += [f"![rate]({PLOT.name})", ""]
     lines += [
         "| method | setting | images | bytes | MSE ×1e-3 | LPIPS |",
         "|---|---|---:|---:|---:|---:|",

@@ -158,8 +158,9 @@ class FitOptions:
     margin: float | None = 0.02
     """Keep control points within the canvas plus this fraction of its longer side (None: no
     bound, the paper's setting)."""
-    gradients: bool = False
-    """Offer each flat path a linear or radial gradient fill before each fitting phase."""
+    gradients: bool = True
+    """Offer each flat path a linear or radial gradient fill before each fitting phase (off: every
+    fill flat, the paper)."""
     gradient_cost: float = 1e-6
     """MSE a gradient must remove per parameter it adds over a flat fill."""
 
@@ -382,6 +383,7 @@ PAPER: dict[str, Any] = {
     "finish_pass": False,
     "colour_split": False,
     "missing_rounds": 1,
+    "gradients": False,
 }
 #: How `Config.fast` differs from the default.
 FAST: dict[str, Any] = {"points_per_side": 16, "size": 384, "iterations": 120, "use_lpips": False}

@@ -35,6 +35,7 @@ from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
 from samvg.missing import MissingSettings
 from samvg.missing.stage import BUDGET_POOL, MAX_AUTO_ROUNDS, add_missing_rounds
 from samvg.optimize import FitSettings, fit_scene
+from samvg.optimize.fit import margin_box
 from samvg.optimize.reduce import reduce_paths
 from samvg.optimize.reshape import reshape_scene
 from samvg.sam import SPECS
@@ -398,10 +399,8 @@ def _reduce(
 
 def _box(config: Config, inputs: _Inputs) -> tuple[float, float, float, float]:
     """The canvas plus the margin control points stay in (2 % when no margin is set)."""
-    width, height = inputs.size
     fraction = config.fit.margin if config.fit.margin is not None else 0.02
-    margin = fraction * max(width, height)
-    return (-margin, -margin, width + margin, height + margin)
+    return margin_box(inputs.size, fraction)
 
 
 def _finish_settings(config: Config, inputs: _Inputs) -> FinishSettings:

@@ -78,8 +78,7 @@ class FitSettings:
             perceptual = lpips_loss(target, options.lpips_size, options.lpips_weights)
         bounds = None
         if canvas is not None and options.margin is not None:
-            margin = options.margin * max(canvas)
-            bounds = (-margin, -margin, canvas[0] + margin, canvas[1] + margin)
+            bounds = margin_box(canvas, options.margin)
         return cls(
             steps=options.iterations,
             point_learning_rate=options.point_learning_rate,
@@ -97,6 +96,13 @@ class FitSettings:
 
     def with_steps(self, steps: int) -> FitSettings:
         return replace(self, steps=steps)
+
+
+def margin_box(canvas: tuple[int, int], fraction: float) -> tuple[float, float, float, float]:
+    """The (width, height) canvas grown by ``fraction`` of its longer side on every side, as
+    (x0, y0, x1, y1): where control points are kept."""
+    margin = fraction * max(canvas)
+    return (-margin, -margin, canvas[0] + margin, canvas[1] + margin)
 
 
 @dataclass
