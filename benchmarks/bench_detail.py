@@ -70,6 +70,7 @@ def samvg_record(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dic
         atomic_write_text(folder / f"{entry['id']}.{tag}.svg", svg)
     return {
         "paths": run.result.counts.get("paths", 0),
+        "gradient_fills": run.result.counts.get("gradient_fills", 0),
         "svg_bytes": len(svg.encode()),
         "seconds": run.seconds,
         **measured(run.render(), run.target, lpips),

@@ -144,13 +144,15 @@ def gradient_table(records: list[dict[str, Any]]) -> list[str]:
         "",
         "## Gradient fills against flat fills at equal budgets (issue 13)",
         "",
-        "`samvg --paths N --gradients` against `samvg --paths N`, same images. *better* = "
+        "`samvg --paths N` (gradient fills where they pay, the default) against `samvg --paths N "
+        "--no-gradients`, same images. *better* = "
         "images where gradients give lower MSE **and** lower LPIPS. "
         + _settings_note([r for _, p in complete for r in p.values()]),
         "",
-        "| N | category | images | flat MSE ×1e-3 | gradients MSE ×1e-3 | flat LPIPS | "
-        "gradients LPIPS | flat bytes | gradients bytes | better |",
-        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| N | category | images | flat paths | gradients paths (gradient fills) | flat MSE ×1e-3 "
+        "| gradients MSE ×1e-3 | flat LPIPS | gradients LPIPS | flat bytes | gradients bytes "
+        "| better |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for budget in sorted({b for b, _ in complete}):
         for category in (*CATEGORIES, "all"):
@@ -167,8 +169,14 @@ def gradient_table(records: list[dict[str, Any]]) -> list[str]:
                 s["mse"] < f["mse"] and s["lpips"] < f["lpips"]
                 for f, s in zip(flat, shaded, strict=True)
             )
+            fills = (
+                _mean(shaded, "gradient_fills")
+                if all("gradient_fills" in r for r in shaded)
+                else float("nan")
+            )
             lines.append(
-                f"| {budget} | {category} | {len(group)} | {1e3 * _mean(flat, 'mse'):.2f} | "
+                f"| {budget} | {category} | {len(group)} | {_mean(flat, 'paths'):.1f} | "
+                f"{_mean(shaded, 'paths'):.1f} ({fills:.1f}) | {1e3 * _mean(flat, 'mse'):.2f} | "
                 f"{1e3 * _mean(shaded, 'mse'):.2f} | {_mean(flat, 'lpips'):.3f} | "
                 f"{_mean(shaded, 'lpips'):.3f} | {_mean(flat, 'svg_bytes'):.0f} | "
                 f"{_mean(shaded, 'svg_bytes'):.0f} | {better}/{len(group)} |"
