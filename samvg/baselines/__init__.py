@@ -7,6 +7,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from samvg.baselines.common import WHITE, StepProgress, as_target, blob
@@ -43,7 +45,8 @@ def run_baseline(
     ``fit`` are the settings samvg fits one phase with (its losses, learning rates and steps);
     the optimising baselines run ``steps`` steps in all, by default ``SAMVG_PHASES *
     fit.steps``, so they get samvg's iterations and losses. ``vtracer`` ignores the fitting
-    arguments. Optimising baselines come back as a `VectorImage` on the target's canvas.
+    arguments. Optimising baselines come back as a `VectorImage` on the target's canvas, with
+    flat fills whatever ``fit`` says about gradients.
     """
     if name not in BASELINES:
         raise InputError(f"unknown baseline {name!r}; choose from {', '.join(BASELINES)}")
@@ -54,6 +57,8 @@ def run_baseline(
             raise InputError("give steps, or samvg's fit settings (steps per phase)")
         steps = SAMVG_PHASES * fit.steps
     method = random_init if name == "diffvg" else live
+    if fit is not None:  # DiffVG and LIVE fill flat: samvg's gradient choice is not theirs
+        fit = replace(fit, gradient_cost=None)
     scene = method(
         target,
         path_count,
