@@ -144,8 +144,8 @@ def gradient_table(records: list[dict[str, Any]]) -> list[str]:
         "",
         "## Gradient fills against flat fills at equal budgets (issue 13)",
         "",
-        "`samvg --paths N` (gradient fills where they pay, the default) against `samvg --paths N "
-        "--no-gradients`, same images. *better* = "
+        "`samvg --paths N --gradients` against `samvg --paths N` (flat fills), same images. "
+        "*better* = "
         "images where gradients give lower MSE **and** lower LPIPS. "
         + _settings_note([r for _, p in complete for r in p.values()]),
         "",

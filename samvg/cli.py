@@ -435,7 +435,7 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
         "--gradients",
         action=argparse.BooleanOptionalAction,
         help="let paths take linear or radial gradient fills where they pay for their parameters "
-        "(the default; --no-gradients keeps every fill flat, as the paper preset does)",
+        "(--no-gradients, the default for now, keeps every fill flat)",
     )
     vectorize.add_argument(
         "--no-finish",

@@ -90,9 +90,9 @@ def test_detail_and_paths_are_checked_and_the_paper_runs_one_round():
             Config(**bad)
 
 
-def test_gradient_fills_are_the_default_and_the_paper_keeps_flat_fills():
-    assert Config().fit.gradients and not Config.paper().fit.gradients
-    assert Config.fast().fit.gradients and not Config(gradients=False).fit.gradients
+def test_gradient_fills_are_asked_for_and_the_paper_keeps_flat_fills():
+    assert not Config().fit.gradients and not Config.paper().fit.gradients
+    assert Config(gradients=True).fit.gradients and Config.paper(gradients=True).fit.gradients
 
 
 def test_speed_settings_are_checked_and_the_paper_fits_exactly():
