@@ -24,14 +24,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bench_images import BENCH, REPO, bench_entries, run_samvg
+from bench_images import REPO, bench_entries, run_samvg, setting_value, working_image
 from PIL import Image
 
 import samvg
 from samvg.baselines import render_svg, run_baseline
 from samvg.baselines.vtracer_baseline import trace_once
-from samvg.imaging import resize_longest, to_float_rgb
-from samvg.io import atomic_write_text, read_image
+from samvg.imaging import to_float_rgb
+from samvg.io import atomic_write_text
 from samvg.metrics import load_lpips, lpips_distance
 from samvg.optimize import FitSettings
 
@@ -45,10 +45,6 @@ BASELINE_STEPS = 2 * samvg.Config().fit.iterations
 VTRACER_SWEEP = ((2, 7, 8), (4, 6, 16), (8, 5, 24), (16, 4, 32), (32, 3, 48))
 
 
-def working_image(entry: dict[str, str]) -> np.ndarray:
-    return resize_longest(read_image(BENCH / entry["png"]), 512)[0]
-
-
 def measured(picture: np.ndarray, target: np.ndarray, lpips: Any) -> dict[str, float]:
     picture = np.clip(picture, 0.0, 1.0)
     return {
@@ -57,17 +53,17 @@ def measured(picture: np.ndarray, target: np.ndarray, lpips: Any) -> dict[str, f
     }
 
 
-#: Where samvg's SVGs are also written (``--keep-svg``), for a contact sheet without reruns.
-KEEP_SVG: list[Path] = []
-
-
-def samvg_record(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dict[str, Any]:
+def samvg_record(
+    entry: dict[str, str], config: samvg.Config, lpips: Any, keep_svg: Path | None = None
+) -> dict[str, Any]:
+    """samvg's record at ``config``; with ``keep_svg``, its SVG is also written there (for a
+    contact sheet without reruns)."""
     run = run_samvg(entry, config)
     svg = run.result.image.to_svg()
-    for folder in KEEP_SVG:
-        folder.mkdir(parents=True, exist_ok=True)
+    if keep_svg is not None:
+        keep_svg.mkdir(parents=True, exist_ok=True)
         tag = f"{config.missing.paths}.{'gradients' if config.fit.gradients else 'flat'}"
-        atomic_write_text(folder / f"{entry['id']}.{tag}.svg", svg)
+        atomic_write_text(keep_svg / f"{entry['id']}.{tag}.svg", svg)
     return {
         "paths": run.result.counts.get("paths", 0),
         "gradient_fills": run.result.counts.get("gradient_fills", 0),
@@ -78,7 +74,7 @@ def samvg_record(entry: dict[str, str], config: samvg.Config, lpips: Any) -> dic
 
 
 def baseline_record(entry: dict[str, str], method: str, paths: int, lpips: Any) -> dict[str, Any]:
-    working = working_image(entry)
+    working = working_image(entry)[0]
     target = to_float_rgb(working)
     fit = FitSettings.from_options(samvg.Config().fit, target)
     started = time.perf_counter()
@@ -95,7 +91,7 @@ def baseline_record(entry: dict[str, str], method: str, paths: int, lpips: Any) 
 
 
 def vtracer_record(entry: dict[str, str], setting: tuple[int, int, int], lpips: Any) -> dict:
-    working = working_image(entry)
+    working = working_image(entry)[0]
     target = to_float_rgb(working)
     buffer = io.BytesIO()
     Image.fromarray(working).save(buffer, format="PNG")
@@ -127,6 +123,7 @@ def run_budget(
     budgets: list[int],
     methods: list[str],
     overrides: dict[str, Any],
+    keep_svg: Path | None = None,
 ) -> None:
     lpips = load_lpips()
     for budget in budgets:
@@ -137,12 +134,18 @@ def run_budget(
                     gradients = method == "samvg-gradients"
                     config = samvg.Config(paths=budget, gradients=gradients, **overrides)
                     extra["overrides"] = overrides
-                    save(f"{method}.{budget}", entry, extra, samvg_record, config, lpips)
+                    record = samvg_record
+                    save(f"{method}.{budget}", entry, extra, record, config, lpips, keep_svg)
                 else:
                     save(f"{method}.{budget}", entry, extra, baseline_record, method, budget, lpips)
 
 
-def run_rate(entries: list[dict[str, str]], budgets: list[int], overrides: dict[str, Any]) -> None:
+def run_rate(
+    entries: list[dict[str, str]],
+    budgets: list[int],
+    overrides: dict[str, Any],
+    keep_svg: Path | None = None,
+) -> None:
     lpips = load_lpips()
     for entry in entries:
         for setting in VTRACER_SWEEP:
@@ -155,7 +158,8 @@ def run_rate(entries: list[dict[str, str]], budgets: list[int], overrides: dict[
                 extra["overrides"] = overrides
                 gradients = method == "samvg-gradients"
                 config = samvg.Config(paths=budget, gradients=gradients, **overrides)
-                save(f"rate.{method}.{budget}", entry, extra, samvg_record, config, lpips)
+                name = f"rate.{method}.{budget}"
+                save(name, entry, extra, samvg_record, config, lpips, keep_svg)
 
 
 def main() -> None:
@@ -174,8 +178,6 @@ def main() -> None:
     )
     parser.add_argument("--keep-svg", type=Path, help="also write samvg's SVGs to this folder")
     arguments = parser.parse_args()
-    if arguments.keep_svg is not None:
-        KEEP_SVG.append(arguments.keep_svg)
     overrides = dict(_setting(text) for text in arguments.set)
     if arguments.study == "report":
         from detail_report import write_report
@@ -188,18 +190,16 @@ def main() -> None:
     entries = bench_entries(arguments.per_category, categories)
     budgets = [int(text) for text in arguments.paths.split(",")]
     if arguments.study == "budget":
-        run_budget(entries, budgets, arguments.methods.split(","), overrides)
+        methods = arguments.methods.split(",")
+        run_budget(entries, budgets, methods, overrides, arguments.keep_svg)
     else:
-        run_rate(entries, budgets, overrides)
+        run_rate(entries, budgets, overrides, arguments.keep_svg)
 
 
 def _setting(text: str) -> tuple[str, Any]:
     """``name=value`` with the value read as JSON where it parses (numbers, true, null)."""
     name, _, value = text.partition("=")
-    try:
-        return name, json.loads(value)
-    except json.JSONDecodeError:
-        return name, value
+    return name, setting_value(value)
 
 
 if __name__ == "__main__":

@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import os
 import time
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from PIL import Image
@@ -52,8 +54,30 @@ class BenchRun:
 
     def render(self) -> np.ndarray:
         """The SVG rendered at the working size, clipped to [0, 1]."""
-        height, width = self.target.shape[:2]
-        return np.clip(self.result.image.render(scale=self.scale)[:height, :width], 0, 1)
+        return render_at_working_size(self.result.image, self.scale, self.target.shape)
+
+
+def working_image(entry: dict[str, str], size: int = 512) -> tuple[np.ndarray, float]:
+    """A bench image at the working size (uint8, longer side at most ``size``) and its scale."""
+    return resize_longest(read_image(BENCH / entry["png"]), size)
+
+
+def render_at_working_size(
+    image: samvg.VectorImage, scale: float, shape: tuple[int, ...]
+) -> np.ndarray:
+    """An SVG in input pixels rendered at ``scale``, cropped to the working image's (H, W) and
+    clipped to [0, 1]."""
+    height, width = shape[:2]
+    return np.clip(image.render(scale=scale)[:height, :width], 0, 1)
+
+
+def setting_value(text: str) -> Any:
+    """A setting's value from the command line: JSON where it parses (numbers, true, null),
+    else the text."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return text
 
 
 def run_samvg(entry: dict[str, str], config: samvg.Config) -> BenchRun:

@@ -70,20 +70,19 @@ def run_tree(tree: Path, image: Path, preset: str) -> dict[str, Any]:
     return record
 
 
-def measure(record: dict[str, Any], image: Path, lpips: Any) -> dict[str, Any]:
+def measure(record: dict[str, Any], entry: dict[str, str], lpips: Any) -> dict[str, Any]:
     """MSE and LPIPS of the record's SVG against the image at the 512-px working size."""
     import numpy as np
+    from bench_images import render_at_working_size, working_image
 
     from samvg import VectorImage
-    from samvg.imaging import resize_longest, to_float_rgb
-    from samvg.io import read_image
+    from samvg.imaging import to_float_rgb
     from samvg.metrics import lpips_distance
 
-    original = read_image(image)
-    working, scale = resize_longest(original, 512)
+    working, scale = working_image(entry)
     target = to_float_rgb(working)
     vector = VectorImage.from_svg(record.pop("svg"))
-    picture = np.clip(vector.render(scale=scale), 0.0, 1.0)[: target.shape[0], : target.shape[1]]
+    picture = render_at_working_size(vector, scale, target.shape)
     record["mse"] = float(np.mean((picture - target) ** 2))
     record["lpips"] = lpips_distance(lpips, picture, target)
     return record
@@ -109,7 +108,7 @@ def run_study(old: str, per_category: int, presets: list[str]) -> None:
                         if path.exists():
                             continue
                         image = BENCH / entry["png"]
-                        record = measure(run_tree(tree, image, preset), image, lpips)
+                        record = measure(run_tree(tree, image, preset), entry, lpips)
                         record.update(id=entry["id"], category=entry["category"], preset=preset)
                         path.parent.mkdir(parents=True, exist_ok=True)
                         atomic_write_text(path, json.dumps(record, indent=1))
@@ -161,6 +160,8 @@ def _quality_rows(old: dict, new: dict, keys: list, preset: str) -> list[str]:
 
 def write_report(old_label: str) -> None:
     old, new = _records(f"old-{old_label}"), _records("new")
+    if not any(key in new for key in old):
+        raise SystemExit(f"no paired records under {RECORDS} for {old_label}: run `run` first")
     lines = [
         "# Speed: per-stage time and quality, before and after (issue 14)",
         "",

@@ -26,7 +26,7 @@ import time
 from typing import Any
 
 import numpy as np
-from bench_images import BENCH, REPO, bench_entries, run_samvg
+from bench_images import BENCH, REPO, bench_entries, run_samvg, setting_value
 
 import samvg
 from samvg.config import FitOptions
@@ -37,19 +37,12 @@ RESULTS = REPO / "benchmarks/results/speed_knobs"
 GEOMETRY = REPO / "benchmarks/results/geometry"
 
 
-def _value(text: str) -> Any:
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError:
-        return text
-
-
 def variants(arguments: list[str]) -> dict[str, dict[str, Any]]:
     parsed = {}
     for argument in arguments:
         name, _, settings = argument.partition("=")
         pairs = (item.split(":", 1) for item in settings.split(",") if item)
-        parsed[name] = {key: _value(value) for key, value in pairs}
+        parsed[name] = {key: setting_value(value) for key, value in pairs}
     return parsed
 
 
@@ -129,9 +122,9 @@ def pipeline_study(chosen: dict[str, dict[str, Any]], log: Log) -> None:
 
 
 def main() -> None:
-    study, chosen = sys.argv[1], variants(sys.argv[2:])
-    if study not in ("fit", "pipeline") or not chosen:
+    if len(sys.argv) < 3 or sys.argv[1] not in ("fit", "pipeline"):
         raise SystemExit(__doc__)
+    study, chosen = sys.argv[1], variants(sys.argv[2:])
     log = Log(study)
     log(f"# {time.strftime('%Y-%m-%d %H:%M')} {study}: {' '.join(sys.argv[2:])}")
     (fit_study if study == "fit" else pipeline_study)(chosen, log)

@@ -19,13 +19,19 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from bench_images import BENCH, REPO, bench_entries, run_samvg, vtracer_default
+from bench_images import (
+    REPO,
+    bench_entries,
+    render_at_working_size,
+    run_samvg,
+    vtracer_default,
+    working_image,
+)
 from PIL import Image, ImageDraw
 
 import samvg
 from samvg.baselines import render_svg
-from samvg.imaging import resize_longest, to_float_rgb
-from samvg.io import read_image
+from samvg.imaging import to_float_rgb
 
 CELL = 256
 CAPTION = 30
@@ -81,14 +87,14 @@ def row_from_svgs(entry: dict[str, str], folder: Path) -> list[Image.Image]:
     """Target | every saved SVG of the image | VTracer's default, with paths, MSE and bytes."""
     from samvg import VectorImage
 
-    working = resize_longest(read_image(BENCH / entry["png"]), 512)[0]
+    working, scale = working_image(entry)
     target = to_float_rgb(working)
     height, width = target.shape[:2]
     row = [cell(target, entry["id"][:36])]
     for path in sorted(folder.glob(f"{entry['id']}.*.svg")):
         svg = path.read_text()
         image = VectorImage.from_svg(svg)
-        picture = np.clip(image.render(scale=width / image.width), 0, 1)[:height, :width]
+        picture = render_at_working_size(image, scale, target.shape)
         error = float(np.mean((picture - target) ** 2))
         tag = path.name[len(entry["id"]) + 1 : -4]
         row.append(cell(picture, f"{tag}: {len(image.paths)}p {error * 1e3:.2f}e-3 "

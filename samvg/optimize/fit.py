@@ -249,7 +249,7 @@ def fit_scene(
     Colours are clamped to [0, 1] after every step; a fit that diverges to non-finite values
     raises `SamvgError`.
     """
-    _check_target(target, scene)
+    target_tensor = _check_target(target, scene)
     if underlay is not None:
         underlay = np.asarray(underlay, np.float64)
         if underlay.shape != np.shape(target):
@@ -260,9 +260,10 @@ def fit_scene(
     losses: list[float] = []
     if coarse:
         width, height = -(-scene.width // 2), -(-scene.height // 2)
+        small_scene = scene.on_canvas(width, height, 0.5)
         small = _fit_level(
-            scene.on_canvas(width, height, 0.5),
-            halve(np.asarray(target, np.float32)),
+            small_scene,
+            _check_target(halve(target_tensor.numpy()), small_scene),
             replace(settings, steps=coarse, bounds=_halved(settings.bounds)),
             on_step,
             underlay=None if underlay is None else halve(underlay),
@@ -270,7 +271,7 @@ def fit_scene(
         scene = small.scene.on_canvas(scene.width, scene.height, 2.0)
         losses = small.losses
         settings = replace(settings, steps=settings.steps - coarse)
-    full = _fit_level(scene, target, settings, on_step, coarse, underlay)
+    full = _fit_level(scene, target_tensor, settings, on_step, coarse, underlay)
     return FitResult(full.scene, losses + full.losses)
 
 
@@ -292,20 +293,19 @@ def _halved(
 
 def _fit_level(
     scene: Scene,
-    target: np.ndarray,
+    target: torch.Tensor,
     settings: FitSettings,
     on_step: StepCallback | None = None,
     first_step: int = 0,
     underlay: np.ndarray | None = None,
 ) -> FitResult:
-    """Adam on one canvas size: ``settings.steps`` steps (progress counted from
-    ``first_step``)."""
-    target_tensor = _check_target(target, scene)
+    """Adam on one canvas size, against ``target`` (checked, float32): ``settings.steps`` steps
+    (progress counted from ``first_step``)."""
     parameters = _Parameters(scene, settings, underlay)
     losses: list[float] = []
     if settings.steps > 0 and scene.path_count > 0:
         optimizer = parameters.optimizer(settings)
-        objective = _Objective(target_tensor, settings, segment_indices(scene.offsets))
+        objective = _Objective(target, settings, segment_indices(scene.offsets))
         with single_torch_thread():
             for step in range(settings.steps):
                 optimizer.zero_grad(set_to_none=True)
