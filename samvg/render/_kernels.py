@@ -49,7 +49,7 @@ import math
 import numpy as np
 from numba import njit
 
-from samvg.render._paint_kernels import FLAT, paint_backward, paint_colour
+from samvg.render._paint_kernels import FLAT, PARAMS, paint_row, paint_row_backward
 
 _MAX_PIECES = 256
 _EPS_ACC = 1e-9
@@ -338,6 +338,7 @@ def render_forward(
                 for ch in range(3):
                     canvas[y, x, ch] = background[ch]
     n_paths = box.shape[0]
+    rgb = np.empty((canvas.shape[1], 3), np.float64)  # a gradient's colours along one box row
     for p in range(n_paths):
         bw = box[p, 2]
         bh = box[p, 3]
@@ -357,6 +358,8 @@ def render_forward(
             y = by0 + r
             base = o + r * stride
             wind = 0.0
+            if not flat:
+                paint_row(kinds, stops, params, p, y, bx0, bw, rgb)
             for c in range(bw):
                 k = base + c
                 wind += acc[k]
@@ -369,7 +372,9 @@ def render_forward(
                 cov = min(1.0, abs(wind))
                 if cov > 0.0:
                     if not flat:
-                        cr, cg, cb = paint_colour(kinds, stops, params, p, x + 0.5, y + 0.5)
+                        cr = rgb[c, 0]
+                        cg = rgb[c, 1]
+                        cb = rgb[c, 2]
                     ac = a * cov
                     keep_c = 1.0 - ac
                     canvas[y, x, 0] = canvas[y, x, 0] * keep_c + cr * ac
@@ -592,6 +597,69 @@ def _path_edges_backward(
 
 
 @njit(cache=True, nogil=True)
+def _path_pixels_backward(
+    grad_out: np.ndarray, p: int, bx0: int, by0: int, bw: int, bh: int, o: int,
+    colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
+    kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
+    rgb: np.ndarray, grgb: np.ndarray, gsum: np.ndarray,
+) -> tuple[float, float, float, float]:  # fmt: skip
+    """The box pixels of path ``p``: dL/dcov into ``dcov``, ``grad_out`` passed under the path.
+
+    Returns dL/d its RGBA; a gradient path's RGB gradient goes to its paint parameters instead
+    (added to ``gsum``, row by row; ``rgb`` and ``grgb`` are scratch rows of the canvas width).
+    """
+    a = colors[p, 3]
+    cr = colors[p, 0]
+    cg = colors[p, 1]
+    cb = colors[p, 2]
+    flat = kinds[p] == FLAT
+    stride = bw + 1
+    sr = 0.0
+    sg = 0.0
+    sb = 0.0
+    sa = 0.0
+    for r in range(bh):
+        y = by0 + r
+        if not flat:
+            paint_row(kinds, stops, params, p, y, bx0, bw, rgb)
+        for c in range(bw):
+            x = bx0 + c
+            k = o + r * stride + c
+            g0 = grad_out[y, x, 0]
+            g1 = grad_out[y, x, 1]
+            g2 = grad_out[y, x, 2]
+            if not flat:
+                cr = rgb[c, 0]
+                cg = rgb[c, 1]
+                cb = rgb[c, 2]
+            dot = g0 * (cr - under[k, 0]) + g1 * (cg - under[k, 1]) + g2 * (cb - under[k, 2])
+            dcov[r * stride + c] = a * dot
+            cov = min(1.0, abs(acc[k]))
+            if cov > 0.0:
+                ac = a * cov
+                if flat:
+                    sr += g0 * ac
+                    sg += g1 * ac
+                    sb += g2 * ac
+                else:
+                    grgb[c, 0] = g0 * ac
+                    grgb[c, 1] = g1 * ac
+                    grgb[c, 2] = g2 * ac
+                sa += cov * dot
+                keep = 1.0 - ac
+                grad_out[y, x, 0] = g0 * keep
+                grad_out[y, x, 1] = g1 * keep
+                grad_out[y, x, 2] = g2 * keep
+            elif not flat:
+                grgb[c, 0] = 0.0
+                grgb[c, 1] = 0.0
+                grgb[c, 2] = 0.0
+        if not flat:
+            paint_row_backward(kinds, stops, params, p, y, bx0, bw, grgb, gsum)
+    return sr, sg, sb, sa
+
+
+@njit(cache=True, nogil=True)
 def render_backward(
     grad_out: np.ndarray, verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray,
     off: np.ndarray, colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
@@ -609,6 +677,9 @@ def render_backward(
     gverts = np.zeros(verts.shape, np.float64)
     gcol = np.zeros((n_paths, 4), np.float64)
     gparams = np.zeros(params.shape, np.float64)
+    rgb = np.empty((grad_out.shape[1], 3), np.float64)
+    grgb = np.empty((grad_out.shape[1], 3), np.float64)
+    gsum = np.zeros(PARAMS, np.float64)
     for p in range(n_paths - 1, -1, -1):
         bw = box[p, 2]
         bh = box[p, 3]
@@ -616,49 +687,13 @@ def render_backward(
             continue
         bx0 = box[p, 0]
         by0 = box[p, 1]
-        a = colors[p, 3]
-        cr = colors[p, 0]
-        cg = colors[p, 1]
-        cb = colors[p, 2]
-        flat = kinds[p] == FLAT
-        stride = bw + 1
         o = off[p]
-        sr = 0.0
-        sg = 0.0
-        sb = 0.0
-        sa = 0.0
-        for r in range(bh):
-            y = by0 + r
-            for c in range(bw):
-                x = bx0 + c
-                k = o + r * stride + c
-                g0 = grad_out[y, x, 0]
-                g1 = grad_out[y, x, 1]
-                g2 = grad_out[y, x, 2]
-                if not flat:
-                    cr, cg, cb = paint_colour(kinds, stops, params, p, x + 0.5, y + 0.5)
-                dot = g0 * (cr - under[k, 0]) + g1 * (cg - under[k, 1]) + g2 * (cb - under[k, 2])
-                dcov[r * stride + c] = a * dot
-                cov = min(1.0, abs(acc[k]))
-                if cov > 0.0:
-                    ac = a * cov
-                    if flat:
-                        sr += g0 * ac
-                        sg += g1 * ac
-                        sb += g2 * ac
-                    else:
-                        paint_backward(
-                            kinds, stops, params, p, x + 0.5, y + 0.5,
-                            g0 * ac, g1 * ac, g2 * ac, gparams,
-                        )  # fmt: skip
-                    sa += cov * dot
-                    keep = 1.0 - ac
-                    grad_out[y, x, 0] = g0 * keep
-                    grad_out[y, x, 1] = g1 * keep
-                    grad_out[y, x, 2] = g2 * keep
-        gcol[p, 0] = sr
-        gcol[p, 1] = sg
-        gcol[p, 2] = sb
-        gcol[p, 3] = sa
+        gsum[:] = 0.0
+        gcol[p, 0], gcol[p, 1], gcol[p, 2], gcol[p, 3] = _path_pixels_backward(
+            grad_out, p, bx0, by0, bw, bh, o, colors, acc, under, dcov,
+            kinds, stops, params, rgb, grgb, gsum,
+        )  # fmt: skip
+        if kinds[p] != FLAT:
+            gparams[p, :] = gsum
         _path_edges_backward(verts, path_vstart, p, bx0, by0, bw, bh, acc, dcov, o, gverts)
     return gverts, gcol, gparams
