@@ -62,7 +62,7 @@ class _Paths:
 
     def scene(self, like: Scene) -> Scene:
         paths = [(self.points[i], self.paints[i]) for i in np.flatnonzero(self.alive)]
-        return Scene.from_paths(like.width, like.height, paths, like.background, like.frame)
+        return like.with_paths(paths)
 
 
 def _candidate_pairs(
@@ -85,7 +85,15 @@ def _candidate_pairs(
 def _union_outline(lower: BaseGeometry, upper: BaseGeometry) -> tuple[BaseGeometry | None, bool]:
     """The union of two areas as one hole-free polygon (or None), and whether a gap between
     them had to be closed (its vertices are then new). Areas that meet only at a point (or
-    across a gap only that narrow) do not make one polygon."""
+    across a gap only that narrow) do not make one polygon, nor do areas GEOS cannot combine
+    (a topology error on nearly degenerate outlines: the two paths then stay as they are)."""
+    try:
+        return _union_of(lower, upper)
+    except shapely.errors.GEOSException:
+        return None, False
+
+
+def _union_of(lower: BaseGeometry, upper: BaseGeometry) -> tuple[BaseGeometry | None, bool]:
     radius = MERGE_DISTANCE / 2.0 + 0.01
     grown = [shapely.buffer(area, radius, join_style="mitre") for area in (lower, upper)]
     if shapely.intersection(*grown).area < 2.0 * radius * MIN_CONTACT:

@@ -1,6 +1,7 @@
 """Merging: touching paths of near-equal colour become one where the picture allows it."""
 
 import numpy as np
+import shapely
 
 from samvg.finish import merge_paths
 from tests.finish.shapes import BLUE, RED, ellipse, is_simple, mean_abs_diff, scene_of, square
@@ -63,3 +64,14 @@ def test_translucent_paths_merge_only_where_they_do_not_overlap():
     overlapping = scene_of((square(100, 100, 100), pink), (square(150, 100, 100), pink))
     assert merge_paths(touching)[1]["merged"] == 1
     assert merge_paths(overlapping)[1]["merged"] == 0
+
+
+def test_a_topology_error_in_geos_leaves_the_pair_unmerged(monkeypatch):
+    def fails(*_args, **_kwargs):
+        raise shapely.errors.GEOSException("TopologyException: side location conflict")
+
+    monkeypatch.setattr(shapely, "intersection", fails)
+    scene = scene_of((square(100, 100, 100), RED), (square(200, 100, 100), RED))
+    merged, counts = merge_paths(scene)
+    assert counts == {"merged": 0}
+    assert np.array_equal(merged.points, scene.points)
