@@ -434,8 +434,8 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
     vectorize.add_argument(
         "--gradients",
         action=argparse.BooleanOptionalAction,
-        help="let paths take linear or radial gradient fills where they pay for their parameters "
-        "(--no-gradients, the default for now, keeps every fill flat)",
+        help="let paths and the background take linear or radial gradient fills where they pay "
+        "for their parameters (the default; --no-gradients keeps every fill flat, as the paper)",
     )
     vectorize.add_argument(
         "--no-finish",

@@ -458,6 +458,7 @@ def _finish(scene: Scene, target: np.ndarray, result: PipelineResult, simple: bo
     result.counts["gradient_fills"] = sum(
         not isinstance(paint, FlatPaint) for paint in result.image.scene.paints
     )
+    result.counts["background_gradient"] = int(result.image.scene.background_gradient is not None)
 
 
 def vectorize(

@@ -13,6 +13,9 @@ point. Pixel (row r, column c) is the square [c, c+1] × [r, r+1].
 Paints are immutable values, one per path: a flat RGBA fill, or a linear or radial gradient
 (2 to 4 stops, geometry in the scene's pixels, one opacity for the whole fill). Every paint has
 ``rgba``, a flat stand-in (its mean stop colour) for the steps that compare fills by colour.
+
+The background is an opaque RGB colour, or an opaque linear or radial gradient
+(``background_gradient``); with a gradient, ``background`` holds its flat stand-in.
 """
 
 from __future__ import annotations
@@ -156,6 +159,8 @@ class RadialGradient(_Gradient):
 
 Paint = FlatPaint | LinearGradient | RadialGradient
 """Every paint a path can have."""
+BackgroundGradient = LinearGradient | RadialGradient
+"""What a background can be besides a flat colour (opaque)."""
 
 
 @dataclass(frozen=True)
@@ -177,6 +182,37 @@ def _check_background(background: Sequence[float] | None) -> RGB | None:
     return (values[0], values[1], values[2])
 
 
+def _check_background_gradient(gradient: object) -> BackgroundGradient | None:
+    if gradient is None:
+        return None
+    if not isinstance(gradient, (LinearGradient, RadialGradient)):
+        raise InputError(
+            f"a background gradient must be a linear or radial gradient, got {gradient!r}"
+        )
+    if not gradient.opaque:
+        raise InputError(f"a background gradient must be opaque, got opacity {gradient.opacity}")
+    return gradient
+
+
+def _pack(paths: Sequence[tuple[np.ndarray, Paint]]) -> tuple[np.ndarray, np.ndarray]:
+    """Packed (N, 2) points and (P + 1) offsets of (points (3K, 2), paint) pairs."""
+    arrays = [np.asarray(points, dtype=np.float64) for points, _ in paths]
+    for index, array in enumerate(arrays):
+        if array.ndim != 2 or array.shape[1] != 2 or array.shape[0] < 3 or array.shape[0] % 3:
+            raise InputError(
+                f"path {index} points must have shape (3K, 2) with K >= 1, got {array.shape}"
+            )
+    counts = [len(array) for array in arrays]
+    points = np.concatenate(arrays) if arrays else np.zeros((0, 2))
+    return points, np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+
+
+def _flat_paints(colours: np.ndarray) -> tuple[Paint, ...]:
+    """Flat fills of RGBA ``colours`` (P, 4), clipped to [0, 1]."""
+    clipped = np.clip(np.asarray(colours, dtype=np.float64), 0.0, 1.0)
+    return tuple(FlatPaint(tuple(row)) for row in clipped.reshape(-1, 4))
+
+
 def _check_canvas(value: object, name: str) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise InputError(f"canvas {name} must be a positive integer, got {value!r}")
@@ -195,6 +231,9 @@ class Scene:
     background: RGB | None = None
     frame: Frame | None = None
     """The input canvas; None when the scene is already in input pixels."""
+    background_gradient: BackgroundGradient | None = None
+    """An opaque gradient drawn behind the paths; ``background`` is then its flat stand-in (the
+    mean stop colour), whatever was given."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "width", _check_canvas(self.width, "width"))
@@ -217,7 +256,10 @@ class Scene:
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "offsets", offsets)
         object.__setattr__(self, "paints", tuple(self.paints))
-        object.__setattr__(self, "background", _check_background(self.background))
+        gradient = _check_background_gradient(self.background_gradient)
+        object.__setattr__(self, "background_gradient", gradient)
+        background = self.background if gradient is None else gradient.rgba[:3]
+        object.__setattr__(self, "background", _check_background(background))
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -228,23 +270,19 @@ class Scene:
         paths: Sequence[tuple[np.ndarray, Paint]],
         background: Sequence[float] | None = None,
         frame: Frame | None = None,
+        background_gradient: BackgroundGradient | None = None,
     ) -> Scene:
         """A scene from (points (3K, 2), paint) pairs in paint order."""
-        arrays = [np.asarray(points, dtype=np.float64) for points, _ in paths]
-        for index, array in enumerate(arrays):
-            if array.ndim != 2 or array.shape[1] != 2 or array.shape[0] < 3 or array.shape[0] % 3:
-                raise InputError(
-                    f"path {index} points must have shape (3K, 2) with K >= 1, got {array.shape}"
-                )
-        counts = [len(array) for array in arrays]
+        points, offsets = _pack(paths)
         return cls(
             width,
             height,
-            np.concatenate(arrays) if arrays else np.zeros((0, 2)),
-            np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+            points,
+            offsets,
             tuple(paint for _, paint in paths),
             _check_background(background),
             frame,
+            background_gradient,
         )
 
     @classmethod
@@ -257,11 +295,19 @@ class Scene:
         colours: np.ndarray,
         background: Sequence[float] | None = None,
         frame: Frame | None = None,
+        background_gradient: BackgroundGradient | None = None,
     ) -> Scene:
         """Packed points and offsets with flat RGBA ``colours`` (P, 4), clipped to [0, 1]."""
-        clipped = np.clip(np.asarray(colours, dtype=np.float64), 0.0, 1.0)
-        paints = tuple(FlatPaint(tuple(row)) for row in clipped.reshape(-1, 4))
-        return cls(width, height, points, offsets, paints, _check_background(background), frame)
+        return cls(
+            width,
+            height,
+            points,
+            offsets,
+            _flat_paints(colours),
+            _check_background(background),
+            frame,
+            background_gradient,
+        )
 
     # ------------------------------------------------------------------ views
     @property
@@ -298,20 +344,32 @@ class Scene:
 
     @property
     def parameter_count(self) -> int:
-        """Coordinates and paint values of all paths: 6K + 4 per flat path."""
-        return int(2 * len(self.points)) + sum(paint.parameter_count for paint in self.paints)
+        """Coordinates and paint values of all paths (6K + 4 per flat path), plus what a
+        background gradient adds over a flat background (whose colour is not counted)."""
+        paths = int(2 * len(self.points)) + sum(paint.parameter_count for paint in self.paints)
+        if self.background_gradient is None:
+            return paths
+        # less its fixed opacity and the RGB it replaces
+        return paths + self.background_gradient.parameter_count - 4
 
     # ------------------------------------------------------------------ derived scenes
     def with_geometry(self, points: np.ndarray, colours: np.ndarray | None = None) -> Scene:
         """The same paths with new packed ``points`` and, optionally, new flat colours."""
         if colours is None:
             return replace(self, points=points)
-        return Scene.from_arrays(
-            self.width, self.height, points, self.offsets, colours, self.background, self.frame
+        return replace(self, points=points, paints=_flat_paints(colours))
+
+    def with_paths(self, paths: Sequence[tuple[np.ndarray, Paint]]) -> Scene:
+        """These (points (3K, 2), paint) pairs, in paint order, in place of this scene's paths
+        (canvas, background and frame kept)."""
+        points, offsets = _pack(paths)
+        return replace(
+            self, points=points, offsets=offsets, paints=tuple(paint for _, paint in paths)
         )
 
     def with_background(self, background: Sequence[float] | None) -> Scene:
-        return replace(self, background=_check_background(background))
+        """The scene over a flat ``background`` (None: white); a background gradient goes."""
+        return replace(self, background=_check_background(background), background_gradient=None)
 
     def stacked(self, above: Scene) -> Scene:
         """This scene with the paths of ``above`` painted on top."""
@@ -326,38 +384,35 @@ class Scene:
 
     def subset(self, keep: Sequence[int] | np.ndarray) -> Scene:
         """Only the paths at indices ``keep`` (in the order given)."""
-        indices = [int(i) for i in keep]
-        return Scene.from_paths(
-            self.width,
-            self.height,
-            [(self.path_points(i), self.paints[i]) for i in indices],
-            self.background,
-            self.frame,
-        )
+        return self.with_paths([(self.path_points(int(i)), self.paints[int(i)]) for i in keep])
 
     def in_input_pixels(self) -> Scene:
         """The scene on the input canvas (``frame``), coordinates divided by its scale."""
         if self.frame is None:
             return self
-        return Scene(
-            self.frame.width,
-            self.frame.height,
-            self.points / self.frame.scale,
-            self.offsets,
-            tuple(paint.scaled(1.0 / self.frame.scale) for paint in self.paints),
-            self.background,
-            None,
+        factor = 1.0 / self.frame.scale
+        gradient = self.background_gradient
+        return replace(
+            self,
+            width=self.frame.width,
+            height=self.frame.height,
+            points=self.points / self.frame.scale,
+            paints=tuple(paint.scaled(factor) for paint in self.paints),
+            frame=None,
+            background_gradient=None if gradient is None else gradient.scaled(factor),
         )
 
     def on_canvas(self, width: int, height: int, factor: float) -> Scene:
         """The scene drawn ``factor`` times as large on a ``width`` × ``height`` canvas (points
         and gradient geometry scaled; paths, paints and frame kept)."""
+        gradient = self.background_gradient
         return replace(
             self,
             width=width,
             height=height,
             points=self.points * factor,
             paints=tuple(paint.scaled(factor) for paint in self.paints),
+            background_gradient=None if gradient is None else gradient.scaled(factor),
         )
 
     def render(self, scale: float = 1.0) -> np.ndarray:

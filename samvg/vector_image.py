@@ -123,13 +123,19 @@ class VectorImage:
     @classmethod
     def from_svg(cls, text: str) -> VectorImage:
         """Parse SVG made of filled shapes (see `samvg.svg.reader.read_svg`): a full-canvas
-        ``<rect>`` drawn first becomes the background. Elements or attributes this model cannot
-        represent raise :class:`InputError` naming them."""
+        ``<rect>`` drawn first becomes the background (a colour or a gradient). Elements or
+        attributes this model cannot represent raise :class:`InputError` naming them."""
         parsed = read_svg(text)
         paths = [
             (points, FlatPaint(fill) if isinstance(fill, tuple) else fill)
             for points, fill in parsed.paths
         ]
         return cls.from_scene(
-            Scene.from_paths(parsed.width, parsed.height, paths, parsed.background)
+            Scene.from_paths(
+                parsed.width,
+                parsed.height,
+                paths,
+                parsed.background,
+                background_gradient=parsed.background_gradient,
+            )
         )

@@ -90,9 +90,14 @@ def test_detail_and_paths_are_checked_and_the_paper_runs_one_round():
             Config(**bad)
 
 
-def test_gradient_fills_are_asked_for_and_the_paper_keeps_flat_fills():
-    assert not Config().fit.gradients and not Config.paper().fit.gradients
-    assert Config(gradients=True).fit.gradients and Config.paper(gradients=True).fit.gradients
+def test_gradient_fills_are_the_default_and_the_paper_keeps_flat_fills():
+    assert Config().fit.gradients and not Config.paper().fit.gradients
+    assert not Config(gradients=False).fit.gradients
+    assert Config.paper(gradients=True).fit.gradients
+
+
+def test_rounds_fit_their_new_paths_except_in_the_paper():
+    assert not Config().missing.refit_scene and Config.paper().missing.refit_scene
 
 
 def test_speed_settings_are_checked_and_the_paper_fits_exactly():

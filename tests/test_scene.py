@@ -64,3 +64,39 @@ def test_bad_scenes_are_refused():
         FlatPaint((1.5, 0, 0))
     with pytest.raises(InputError, match="width"):
         Scene(0, 8)
+
+
+def test_a_background_gradient_is_kept_by_every_derived_scene():
+    from dataclasses import replace
+
+    from samvg.finish import FinishSettings, finish_scene
+    from samvg.optimize.reshape import reshape_scene
+    from samvg.scene import LinearGradient
+
+    ramp = LinearGradient(((0.0, (1, 0, 0)), (1.0, (0, 0, 1))), 1.0, (4.0, 2.0), (36.0, 18.0))
+    red, blue = FlatPaint((1, 0, 0)), FlatPaint((0, 0, 1, 0.5))
+    scene = Scene.from_paths(
+        40, 20, [(triangle(1, 1, 5), red), (square(8, 2, 6), blue)],
+        frame=Frame(80, 40, 0.5), background_gradient=ramp,
+    )  # fmt: skip
+    assert scene.background == (0.5, 0.0, 0.5)  # the flat stand-in: the mean stop colour
+    assert scene.parameter_count == (6 * 3 + 4) + (6 * 4 + 4) + 9  # 9 over a flat colour
+    kept = [
+        scene.subset([1]),
+        scene.with_paths([]),
+        scene.with_geometry(scene.points + 1),
+        scene.with_geometry(scene.points, np.ones((2, 4))),
+        scene.stacked(scene),
+        replace(scene, background=(0, 1, 0)),  # the stand-in follows the gradient
+        finish_scene(scene, FinishSettings(colours=1)).scene,
+        reshape_scene(scene, 0.5, 8, (-4, -4, 44, 24))[0],
+    ]
+    for derived in kept:
+        assert derived.background_gradient == ramp and derived.background == scene.background
+    big = scene.in_input_pixels()
+    assert big.background_gradient == ramp.scaled(2.0) and big.frame is None
+    assert scene.on_canvas(20, 10, 0.5).background_gradient == ramp.scaled(0.5)
+    flat = scene.with_background((0, 1, 0))
+    assert flat.background_gradient is None and flat.background == (0.0, 1.0, 0.0)
+    rendered = Scene(40, 20, background_gradient=ramp).render()
+    assert rendered[10, 0, 0] > 0.9 and rendered[10, -1, 2] > 0.9  # red to blue, left to right

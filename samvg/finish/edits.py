@@ -23,7 +23,7 @@ def apply_edits(scene: Scene, edits: Mapping[int, Edit]) -> Scene:
             paths.extend(edits[index])
         else:
             paths.append((points, paint))
-    return Scene.from_paths(scene.width, scene.height, paths, scene.background, scene.frame)
+    return scene.with_paths(paths)
 
 
 def edit_counts(step: str, scene: Scene, edits: Mapping[int, Edit], holes: int) -> dict[str, int]:

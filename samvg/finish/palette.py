@@ -4,6 +4,8 @@ they are."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from skimage.color import lab2rgb, rgb2lab
 from sklearn.cluster import KMeans
@@ -44,15 +46,7 @@ def snap_colours(scene: Scene, n: int) -> tuple[Scene, dict[str, int]]:
         for row, paint in zip(snapped, scene.paints, strict=True)
     )
     changed = int(np.sum(np.any(snapped != colours, axis=1)))
-    result = Scene(
-        scene.width,
-        scene.height,
-        scene.points,
-        scene.offsets,
-        paints,
-        scene.background,
-        scene.frame,
-    )
+    result = replace(scene, paints=paints)
     return result, {
         "palette_colours": len(np.unique(snapped[:, :3], axis=0)),
         "palette_changed": changed,

@@ -4,8 +4,9 @@ loss = MSE to the target + λ_Xing · Xing loss + λ_LPIPS · LPIPS (the paper's
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
+from typing import cast
 
 import numpy as np
 import torch
@@ -18,7 +19,7 @@ from samvg.optimize.paint_choice import choose_gradients
 from samvg.render import rasterize
 from samvg.render._paint_kernels import MAX_STOPS, RADIAL
 from samvg.render.rasterizer import GradientPaints
-from samvg.scene import Scene
+from samvg.scene import RGB, BackgroundGradient, Paint, Scene
 
 #: A phase with ``plateau_steps`` set stops when its best loss improved by less than this
 #: fraction over the last ``plateau_steps`` steps.
@@ -59,8 +60,9 @@ class FitSettings:
     """Stop a phase (each size of it) once its loss has stopped improving over this many steps
     (None: always run every step)."""
     gradient_cost: float | None = None
-    """Offer every flat path a gradient fill before fitting (`samvg.optimize.paint_choice`),
-    bought when it removes this much MSE per added parameter; None: fills stay as they are."""
+    """Offer every flat path, and a flat background, a gradient fill before fitting
+    (`samvg.optimize.paint_choice`), bought when it removes this much MSE per added parameter;
+    None: fills stay as they are."""
 
     @classmethod
     def from_options(
@@ -140,10 +142,38 @@ def _check_target(target: np.ndarray, scene: Scene) -> torch.Tensor:
     return torch.from_numpy(np.ascontiguousarray(array))
 
 
+class _GradientVariables:
+    """Adam's view of gradient paints (`GradientPaints` rows): their geometry (pixels, moved at
+    the points' learning rate) and their stop offsets and colours (the colours' rate)."""
+
+    def __init__(self, paints: Sequence[Paint]) -> None:
+        gradients = GradientPaints.of(paints)
+        self.kinds, self.stops = gradients.kinds, gradients.stops
+        params = gradients.params.to(torch.float32)
+        self.geometry = params[:, :4].clone().requires_grad_(True)
+        self.values = params[:, 4:].clone().requires_grad_(True)
+
+    def current(self) -> GradientPaints:
+        return GradientPaints(self.kinds, self.stops, torch.cat([self.geometry, self.values], 1))
+
+    @torch.no_grad()
+    def project(self) -> None:
+        """Stop colours into [0, 1], offsets non-decreasing in [0, 1], radii at least 0.5 px."""
+        self.values.clamp_(0.0, 1.0)
+        offsets = self.values[:, :MAX_STOPS]
+        offsets.copy_(torch.cummax(offsets, dim=1).values)
+        radial = torch.from_numpy(self.kinds == RADIAL)
+        self.geometry[radial, 2] = self.geometry[radial, 2].clamp(min=0.5)
+        if not bool(torch.isfinite(self.geometry).all()):
+            raise SamvgError(_DIVERGED)
+
+    def paints(self, colours: np.ndarray) -> tuple[Paint, ...]:
+        return self.current().paints(colours)
+
+
 class _Parameters:
-    """What Adam moves: packed points, RGBA colours and, for a scene with gradient paints, their
-    geometry (pixels, the points' learning rate) and their stop offsets and colours (the
-    colours' learning rate)."""
+    """What Adam moves: packed points, RGBA colours, the gradient paints of paths and a
+    background gradient (see `_GradientVariables`; none with an ``underlay``)."""
 
     def __init__(
         self, scene: Scene, settings: FitSettings, underlay: np.ndarray | None = None
@@ -155,20 +185,23 @@ class _Parameters:
         if not settings.learn_alpha:
             colours[:, 3] = 1.0
         self.colours = torch.tensor(colours, dtype=torch.float32, requires_grad=True)
-        self.gradients: GradientPaints | None = None
-        self.paint_geometry = self.paint_values = torch.zeros(0)
-        if scene.has_gradients:
-            self.gradients = GradientPaints.of(scene.paints)
-            params = self.gradients.params.to(torch.float32)
-            self.paint_geometry = params[:, :4].clone().requires_grad_(True)
-            self.paint_values = params[:, 4:].clone().requires_grad_(True)
+        self.gradients = _GradientVariables(scene.paints) if scene.has_gradients else None
+        self.background: _GradientVariables | None = None
+        if underlay is None and scene.background_gradient is not None:
+            self.background = _GradientVariables([scene.background_gradient])
+
+    @property
+    def learns(self) -> bool:
+        """Whether there is anything to fit: a path or a background gradient."""
+        return self.scene.path_count > 0 or self.background is not None
 
     def optimizer(self, settings: FitSettings) -> torch.optim.Adam:
         point_group = [self.points]
         colour_group = [self.colours]
-        if self.gradients is not None:
-            point_group.append(self.paint_geometry)
-            colour_group.append(self.paint_values)
+        for variables in (self.gradients, self.background):
+            if variables is not None:
+                point_group.append(variables.geometry)
+                colour_group.append(variables.values)
         return torch.optim.Adam(
             [
                 {"params": point_group, "lr": settings.point_learning_rate},
@@ -177,32 +210,28 @@ class _Parameters:
         )
 
     def render(self) -> torch.Tensor:
-        gradients = None
-        if self.gradients is not None:
-            params = torch.cat([self.paint_geometry, self.paint_values], dim=1)
-            gradients = GradientPaints(self.gradients.kinds, self.gradients.stops, params)
         scene = self.scene
+        background: np.ndarray | torch.Tensor | RGB = scene.background_or_white
+        if self.underlay is not None:
+            background = self.underlay
+        elif self.background is not None:
+            background = self.background.current().image(0, scene.width, scene.height)
         return rasterize(
             self.points,
             self.colours,
             scene.width,
             scene.height,
-            background=scene.background_or_white if self.underlay is None else self.underlay,
+            background=background,
             offsets=scene.offsets,
-            gradients=gradients,
+            gradients=None if self.gradients is None else self.gradients.current(),
         )
 
     @torch.no_grad()
     def project(self, settings: FitSettings) -> None:
         _project(self.points, self.colours, settings)
-        if self.gradients is not None:
-            self.paint_values.clamp_(0.0, 1.0)
-            offsets = self.paint_values[:, :MAX_STOPS]
-            offsets.copy_(torch.cummax(offsets, dim=1).values)
-            radial = torch.from_numpy(self.gradients.kinds == RADIAL)
-            self.paint_geometry[radial, 2] = self.paint_geometry[radial, 2].clamp(min=0.5)
-            if not bool(torch.isfinite(self.paint_geometry).all()):
-                raise SamvgError(_DIVERGED)
+        for variables in (self.gradients, self.background):
+            if variables is not None:
+                variables.project()
 
     def fitted(self) -> Scene:
         points = self.points.detach().numpy().astype(np.float64)
@@ -210,10 +239,13 @@ class _Parameters:
         if not (np.all(np.isfinite(points)) and np.all(np.isfinite(colours))):
             raise SamvgError(_DIVERGED)
         if self.gradients is None:
-            return self.scene.with_geometry(points, colours)
-        params = torch.cat([self.paint_geometry, self.paint_values], dim=1).detach()
-        paints = GradientPaints(self.gradients.kinds, self.gradients.stops, params).paints(colours)
-        return replace(self.scene, points=points, paints=paints)
+            scene = self.scene.with_geometry(points, colours)
+        else:
+            scene = replace(self.scene, points=points, paints=self.gradients.paints(colours))
+        if self.background is None:
+            return scene
+        gradient = cast(BackgroundGradient, self.background.paints(np.ones((1, 4)))[0])
+        return replace(scene, background_gradient=gradient)
 
 
 def _project(points: torch.Tensor, colours: torch.Tensor, settings: FitSettings) -> None:
@@ -237,11 +269,12 @@ def fit_scene(
     on_step: StepCallback | None = None,
     underlay: np.ndarray | None = None,
 ) -> FitResult:
-    """Fit the scene's geometry and paints (flat colours, gradient geometry, stops) to
-    ``target`` (H, W, 3) float in [0, 1], after offering flat paths a gradient when
-    ``settings.gradient_cost`` is set. With an ``underlay`` (H, W, 3), the paths are painted
-    over that fixed image instead of the scene's background (paths added on top of a scene
-    that stays as it is).
+    """Fit the scene's geometry and paints (flat colours, gradient geometry, stops; a
+    background gradient's geometry and stops) to ``target`` (H, W, 3) float in [0, 1], after
+    offering flat paths and a flat background a gradient when ``settings.gradient_cost`` is set.
+    With an ``underlay`` (H, W, 3), the paths are painted over that fixed image instead of the
+    scene's background (paths added on top of a scene that stays as it is), and the background
+    is left alone.
 
     With ``settings.coarse_fraction`` set, that share of the steps runs first on the scene and
     target at half size (a quarter of the pixels to draw), the rest at full size.
@@ -255,7 +288,9 @@ def fit_scene(
         if underlay.shape != np.shape(target):
             raise InputError(f"underlay must have the target's shape, got {underlay.shape}")
     if settings.gradient_cost is not None:
-        scene, _ = choose_gradients(scene, np.asarray(target), settings.gradient_cost)
+        scene, _ = choose_gradients(
+            scene, np.asarray(target), settings.gradient_cost, background=underlay is None
+        )
     coarse = _coarse_steps(scene, settings)
     losses: list[float] = []
     if coarse:
@@ -303,7 +338,7 @@ def _fit_level(
     (progress counted from ``first_step``)."""
     parameters = _Parameters(scene, settings, underlay)
     losses: list[float] = []
-    if settings.steps > 0 and scene.path_count > 0:
+    if settings.steps > 0 and parameters.learns:
         optimizer = parameters.optimizer(settings)
         objective = _Objective(target, settings, segment_indices(scene.offsets))
         with single_torch_thread():

@@ -1,7 +1,9 @@
 """Which paths get a gradient fill: every path starts flat; before a fitting phase each flat path
 is offered a linear and a radial gradient, fitted in closed form to the target over the pixels
 where the path shows, and takes the one that lowers the error by more than
-``cost × extra parameters`` (MSE units), else stays flat. Adam then refines what was chosen.
+``cost × extra parameters`` (MSE units), else stays flat. An opaque flat background is offered
+the same, over the pixels where only it shows (its extra parameters over an RGB colour are those
+of a path's gradient over an RGBA fill). Adam then refines what was chosen.
 
 The closed-form fits (least squares, numpy):
 
@@ -20,12 +22,22 @@ flat fill, so a gradient is bought only where a path would have been worth as mu
 
 from __future__ import annotations
 
+from dataclasses import replace
+from typing import cast
+
 import numpy as np
 from skimage.draw import polygon as fill_polygon
 
 from samvg.errors import InputError
 from samvg.finish.flatten import flatten_paths
-from samvg.scene import FlatPaint, LinearGradient, Paint, RadialGradient, Scene
+from samvg.scene import (
+    BackgroundGradient,
+    FlatPaint,
+    LinearGradient,
+    Paint,
+    RadialGradient,
+    Scene,
+)
 
 DEFAULT_COST = 1e-6
 """MSE a gradient must remove per parameter it adds."""
@@ -135,40 +147,58 @@ def best_paint(
 
 
 def choose_gradients(
-    scene: Scene, target: np.ndarray, cost: float = DEFAULT_COST, start: int = 0
+    scene: Scene,
+    target: np.ndarray,
+    cost: float = DEFAULT_COST,
+    start: int = 0,
+    *,
+    background: bool = True,
 ) -> tuple[Scene, int]:
     """``scene`` with each flat path from index ``start`` on given a gradient where it pays
-    (see the module docstring); returns the scene and how many paths switched."""
+    (see the module docstring), and with ``background`` and ``start`` 0 an opaque flat
+    background too, fitted over the pixels where only it shows; returns the scene and how many
+    paints switched (the background's included)."""
     if np.shape(target) != (scene.height, scene.width, 3):
         raise InputError(
             f"target {np.shape(target)} does not match the {scene.width}x{scene.height} scene"
         )
-    if scene.path_count <= start:
-        return scene, 0
     labels = shown_labels(scene)
     paints = list(scene.paints)
     switched = 0
-    pixels = scene.width * scene.height
     for index in range(start, scene.path_count):
         paint = paints[index]
-        if not isinstance(paint, FlatPaint):
-            continue
-        rows, cols = np.nonzero(labels == index)
-        if len(rows) < MIN_SHOWN_PIXELS:
-            continue
-        xy = np.stack([cols + 0.5, rows + 0.5], axis=1).astype(np.float64)
-        chosen = best_paint(xy, target[rows, cols].astype(np.float64), paint, pixels, cost)
-        if chosen is not paint:
-            paints[index] = chosen
-            switched += 1
+        if isinstance(paint, FlatPaint):
+            chosen = _best_where(labels == index, target, paint, cost)
+            if chosen is not paint:
+                paints[index] = chosen
+                switched += 1
+    gradient = None
+    if background and start == 0:
+        gradient = _background_gradient(scene, labels == -1, target, cost)
+    if gradient is not None:
+        return replace(scene, paints=tuple(paints), background_gradient=gradient), switched + 1
     if not switched:
         return scene, 0
-    return Scene(
-        scene.width,
-        scene.height,
-        scene.points,
-        scene.offsets,
-        tuple(paints),
-        scene.background,
-        scene.frame,
-    ), switched
+    return replace(scene, paints=tuple(paints)), switched
+
+
+def _background_gradient(
+    scene: Scene, shown: np.ndarray, target: np.ndarray, cost: float
+) -> BackgroundGradient | None:
+    """The gradient the scene's opaque flat background takes over its ``shown`` pixels, if one
+    pays (None: no background, a gradient already, or flat is best)."""
+    if scene.background is None or scene.background_gradient is not None:
+        return None
+    flat = FlatPaint((*scene.background, 1.0))
+    chosen = _best_where(shown, target, flat, cost)
+    return None if chosen is flat else cast(BackgroundGradient, chosen)
+
+
+def _best_where(shown: np.ndarray, target: np.ndarray, paint: FlatPaint, cost: float) -> Paint:
+    """`best_paint` over the ``shown`` (H, W) pixels of ``target``; ``paint`` where fewer than
+    `MIN_SHOWN_PIXELS` show."""
+    rows, cols = np.nonzero(shown)
+    if len(rows) < MIN_SHOWN_PIXELS:
+        return paint
+    xy = np.stack([cols + 0.5, rows + 0.5], axis=1).astype(np.float64)
+    return best_paint(xy, target[rows, cols].astype(np.float64), paint, shown.size, cost)

@@ -26,15 +26,11 @@ def reshape_scene(
     outlines = refit_outlines(polygons(vertices, vertex_offsets), tolerance, max_segments)
     x0, y0, x1, y1 = box
     low, high = np.array([x0, y0]), np.array([x1, y1])
-    reshaped = Scene.from_paths(
-        untangled.width,
-        untangled.height,
+    reshaped = untangled.with_paths(
         [
             (np.clip(points, low, high), paint)
             for points, paint in zip(outlines, untangled.paints, strict=True)
-        ],
-        untangled.background,
-        untangled.frame,
+        ]
     )
     counts.update(
         reshape_segments_in=int(scene.segment_counts().sum()),

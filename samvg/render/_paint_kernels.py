@@ -182,3 +182,25 @@ def paint_row_backward(
     gsum[1] = s1
     gsum[2] = s2
     gsum[3] = s3
+
+
+@njit(cache=True, nogil=True)
+def paint_canvas(
+    kinds: np.ndarray, stops: np.ndarray, params: np.ndarray, p: int, image: np.ndarray
+) -> None:
+    """``image`` (H, W, 3) = gradient paint ``p`` at every pixel centre (a gradient background),
+    row by row with `paint_row`."""
+    for y in range(image.shape[0]):
+        paint_row(kinds, stops, params, p, y, 0, image.shape[1], image[y])
+
+
+@njit(cache=True, nogil=True)
+def paint_canvas_backward(
+    kinds: np.ndarray, stops: np.ndarray, params: np.ndarray, p: int, grad: np.ndarray
+) -> np.ndarray:
+    """dL/d params of paint ``p`` (PARAMS,), given dL/d the image of `paint_canvas` ``grad``
+    (H, W, 3), row by row with `paint_row_backward`."""
+    gsum = np.zeros(PARAMS, np.float64)
+    for y in range(grad.shape[0]):
+        paint_row_backward(kinds, stops, params, p, y, 0, grad.shape[1], grad[y], gsum)
+    return gsum

@@ -19,6 +19,7 @@ import torch
 from samvg.errors import InputError
 from samvg.render import _kernels as K
 from samvg.render._paint_kernels import FLAT, LINEAR, MAX_STOPS, PARAMS, RADIAL
+from samvg.render.gradient_image import gradient_image
 from samvg.scene import FlatPaint, LinearGradient, Paint, RadialGradient, Scene
 
 #: Maximum chord error (pixels) of the polyline that replaces each cubic segment.
@@ -48,14 +49,17 @@ def _check_size(width: int, height: int) -> tuple[int, int]:
 
 _NO_BACKGROUND = np.zeros(0, np.float64)
 """Tells the forward kernel the canvas already holds the background image."""
+_NO_IMAGE = torch.zeros(0)
+"""Stands for the background image tensor where there is none (nothing to differentiate)."""
+_Background = Sequence[float] | np.ndarray | torch.Tensor | None
 
 
-def _background(
-    background: Sequence[float] | np.ndarray | None, width: int, height: int
-) -> np.ndarray:
+def _background(background: _Background, width: int, height: int) -> np.ndarray:
     """The opaque RGB (3,) behind the paths, or an (H, W, 3) image to paint them over."""
     if background is None:
         return np.ones(3, np.float64)
+    if isinstance(background, torch.Tensor) and background.dim() == 3:
+        background = background.detach().cpu().numpy()
     if isinstance(background, np.ndarray) and background.ndim == 3:
         if background.shape != (height, width, 3) or not np.all(np.isfinite(background)):
             raise InputError(
@@ -196,6 +200,12 @@ class GradientPaints:
                 paints.append(RadialGradient(stops, opacity, tuple(row[0:2]), radius))
         return tuple(paints)
 
+    def image(self, index: int, width: int, height: int) -> torch.Tensor:
+        """Gradient paint ``index`` over a whole ``width`` × ``height`` canvas, (height, width,
+        3), differentiable with respect to ``params`` (`gradient_image`)."""
+        kind, stops = int(self.kinds[index]), int(self.stops[index])
+        return gradient_image(kind, stops, self.params[index], width, height)
+
     @classmethod
     def flat(cls, count: int) -> GradientPaints:
         return cls(
@@ -224,6 +234,7 @@ class _Rasterize(torch.autograd.Function):
         flat_pts: torch.Tensor,
         colors: torch.Tensor,
         params: torch.Tensor,
+        image: torch.Tensor,
         kinds: np.ndarray,
         stops: np.ndarray,
         starts: np.ndarray,
@@ -244,7 +255,7 @@ class _Rasterize(torch.autograd.Function):
         seg_n, vstart, verts = K.plan_and_flatten(pts, starts, width, height, tol)
         box, off = K.path_boxes(verts, vstart, width, height)
         # needs_input_grad ignores torch.no_grad(); keep backward state only if it can be used.
-        keep = grad_enabled and any(ctx.needs_input_grad[:3])
+        keep = grad_enabled and any(ctx.needs_input_grad[:4])
         n_cells = int(off[-1])
         largest = int(np.max(np.diff(off))) if len(off) > 1 else 0
         out_dtype = np.float64 if flat_pts.dtype == torch.float64 else np.float32
@@ -276,6 +287,7 @@ class _Rasterize(torch.autograd.Function):
         )
         ctx.col_dtype = colors.dtype
         ctx.paint_dtype = params.dtype
+        ctx.image_dtype = image.dtype
         if keep:
             ctx.state = (pts.shape[0], starts, seg_n, vstart, verts, box, off, acc, under, cols)
             ctx.paints = (kinds, stops, paint)
@@ -292,7 +304,7 @@ class _Rasterize(torch.autograd.Function):
         gverts, gcol, gpaint = K.render_backward(
             go, verts, vstart, box, off, cols, acc, under, dcov, *ctx.paints
         )
-        g_pts = g_col = g_paint = None
+        g_pts = g_col = g_paint = g_image = None
         if ctx.needs_input_grad[0]:
             g = K.flatten_backward(gverts, starts, seg_n, vstart, n_ctrl)
             if ctx.clipped is not None:
@@ -302,7 +314,11 @@ class _Rasterize(torch.autograd.Function):
             g_col = torch.from_numpy(gcol).to(dtype=ctx.col_dtype, device=grad_out.device)
         if ctx.needs_input_grad[2]:
             g_paint = torch.from_numpy(gpaint).to(dtype=ctx.paint_dtype, device=grad_out.device)
-        return g_pts, g_col, g_paint, *([None] * 8)
+        if ctx.needs_input_grad[3]:
+            # render_backward has passed the canvas gradient under every path, in reverse paint
+            # order: what is left is the gradient with respect to the canvas before any path.
+            g_image = torch.from_numpy(go).to(dtype=ctx.image_dtype, device=grad_out.device)
+        return g_pts, g_col, g_paint, g_image, *([None] * 8)
 
 
 def rasterize(
@@ -310,7 +326,7 @@ def rasterize(
     colors: torch.Tensor | np.ndarray,
     width: int,
     height: int,
-    background: Sequence[float] | np.ndarray | None = (1.0, 1.0, 1.0),
+    background: _Background = (1.0, 1.0, 1.0),
     *,
     offsets: np.ndarray | None = None,
     tolerance: float = FLATTEN_TOLERANCE,
@@ -327,7 +343,8 @@ def rasterize(
         colors: ``(P, 4)`` straight RGBA in ``[0, 1]`` (used as given, not clamped).
         width, height: canvas size in pixels.
         background: opaque RGB behind the paths, ``None`` meaning white; or an
-            ``(height, width, 3)`` array, an image to paint the paths over.
+            ``(height, width, 3)`` array or tensor, an image to paint the paths over (a tensor
+            receives the gradient: a gradient background drawn by `gradient_image`).
         tolerance: maximum chord error (pixels) when flattening the cubics.
         gradients: linear and radial gradient paints (`GradientPaints`); a path whose kind is
             not flat takes its RGB from them (its alpha stays ``colors[p, 3]``).
@@ -335,8 +352,8 @@ def rasterize(
     Returns:
         ``(height, width, 3)`` tensor, float64 for float64 ``points``, float32 otherwise,
         paths composited with straight-alpha "over" in paint order, nonzero fill rule.
-        Differentiable w.r.t. ``points``, ``colors`` and the gradient parameters (analytic
-        boundary gradients).
+        Differentiable w.r.t. ``points``, ``colors``, the gradient parameters (analytic
+        boundary gradients) and a background image tensor.
 
     Raises:
         InputError (a ValueError): bad shapes, non-finite coordinates/colours (naming the path),
@@ -366,11 +383,13 @@ def rasterize(
             raise InputError(f"path {bad} has a non-finite colour")
     paints = gradients if gradients is not None else GradientPaints.flat(n_paths)
     paints.check(n_paths)
+    image = background if isinstance(background, torch.Tensor) and background.dim() == 3 else None
     try:
         return _Rasterize.apply(
             flat,
             cols,
             paints.params,
+            image if image is not None else _NO_IMAGE,
             paints.kinds,
             paints.stops,
             starts,
@@ -389,12 +408,13 @@ def render_array(
     colors: np.ndarray,
     width: int,
     height: int,
-    background: Sequence[float] | None = (1.0, 1.0, 1.0),
+    background: Sequence[float] | np.ndarray | None = (1.0, 1.0, 1.0),
     offsets: np.ndarray | None = None,
     gradients: GradientPaints | None = None,
 ) -> np.ndarray:
     """`rasterize` for numpy scenes, without gradients: points (P, 3K, 2), or packed (N, 2) with
-    ``offsets``, and RGBA (P, 4) to a float32 (height, width, 3) array."""
+    ``offsets``, and RGBA (P, 4) to a float32 (height, width, 3) array; ``background`` an RGB
+    or an (height, width, 3) image."""
     with torch.no_grad():
         image = rasterize(
             torch.from_numpy(np.asarray(points)).float(),
@@ -408,6 +428,18 @@ def render_array(
     return image.numpy().astype(np.float32, copy=False)
 
 
+def background_image(scene: Scene, scale: float = 1.0) -> np.ndarray | None:
+    """The float64 (H, W, 3) image of the scene's background gradient at ``scale`` × its canvas
+    size (None when its background is flat)."""
+    if scene.background_gradient is None:
+        return None
+    width = max(1, round(scene.width * scale))
+    height = max(1, round(scene.height * scale))
+    with torch.no_grad():
+        paint = GradientPaints.of([scene.background_gradient], scale)
+        return paint.image(0, width, height).numpy()
+
+
 def render_scene(scene: Scene, scale: float = 1.0) -> np.ndarray:
     """Render a `Scene` at ``scale`` × its canvas size: float32 (H, W, 3) in [0, 1], no
     background meaning white."""
@@ -415,12 +447,13 @@ def render_scene(scene: Scene, scale: float = 1.0) -> np.ndarray:
         raise InputError(f"render scale must be a positive number, got {scale}")
     width = max(1, round(scene.width * scale))
     height = max(1, round(scene.height * scale))
+    image = background_image(scene, scale)
     return render_array(
         scene.points * scale,
         scene.colours(),
         width,
         height,
-        background=scene.background_or_white,
+        background=scene.background_or_white if image is None else image,
         offsets=scene.offsets,
         gradients=GradientPaints.of(scene.paints, scale) if scene.has_gradients else None,
     )
@@ -443,3 +476,7 @@ def warmup() -> None:
         requires_grad=True,
     )
     rasterize(box, cols.float(), 4, 4).sum().backward()
+    # A gradient background: its image and its derivatives.
+    ramp = torch.zeros(PARAMS, dtype=torch.float64)
+    ramp[2], ramp[5] = 4.0, 1.0
+    gradient_image(LINEAR, 2, ramp.requires_grad_(True), 4, 4).sum().backward()

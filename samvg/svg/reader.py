@@ -1,5 +1,6 @@
-"""Read SVG text into samvg's scene form: a pixel canvas, an optional background colour and closed
-cubic Bézier paths with straight RGBA fills. That is this module's one job.
+"""Read SVG text into samvg's scene form: a pixel canvas, an optional background (a colour or a
+gradient) and closed cubic Bézier paths with straight RGBA or gradient fills. That is this module's
+one job.
 
 It is built on the maintained library svgelements, which resolves transforms, ``style`` and CSS,
 inheritance through groups and ``<use>``, units, and every path command (absolute or relative,
@@ -107,7 +108,8 @@ _TRANSFORM_COUNTS = {
 _HEX_COLOUR = re.compile(r"^#(?:[0-9a-fA-F]{3,4}|[0-9a-fA-F]{6}|[0-9a-fA-F]{8})$")
 
 _Rgba = tuple[float, float, float, float]
-_Fill = _Rgba | LinearGradient | RadialGradient
+_Gradient = LinearGradient | RadialGradient
+_Fill = _Rgba | _Gradient
 _URL = re.compile(r"url\(\s*#([^)\s]+)\s*\)")
 
 
@@ -117,20 +119,23 @@ class ParsedSvg:
 
     ``paths`` holds ``(points, fill)`` pairs in paint order: ``points`` a float64 (3K, 2) array of
     closed cubic control points in canvas pixels, ``fill`` straight RGBA in [0, 1] or a gradient
-    paint in canvas pixels (see `samvg.svg.gradients`).
+    paint in canvas pixels (see `samvg.svg.gradients`). A gradient background is
+    ``background_gradient`` (canvas pixels), and ``background`` then its mean stop colour.
     """
 
     width: int
     height: int
     background: tuple[float, float, float] | None
     paths: list[tuple[np.ndarray, _Fill]]
+    background_gradient: _Gradient | None = None
 
 
 def read_svg(text: str) -> ParsedSvg:
     """Parse SVG text made of filled shapes into a :class:`ParsedSvg`.
 
     A full-canvas, opaque, axis-aligned ``<rect>`` drawn before any other shape becomes the
-    background. Anything the scene cannot represent raises :class:`InputError` naming the element.
+    background (its colour, or its gradient). Anything the scene cannot represent raises
+    :class:`InputError` naming the element.
     """
     root = _parse_xml(text)
     geometry = _Geometry.of(root)
@@ -150,7 +155,13 @@ def read_svg(text: str) -> ParsedSvg:
         # svgelements computing something this module's checks let through
         reason = f"{type(error).__name__}: {error}"
         raise InputError(f"svg: cannot read the document: {reason}") from None
-    return ParsedSvg(geometry.pixel_width, geometry.pixel_height, scene.background, scene.paths)
+    background = scene.background
+    if isinstance(background, (LinearGradient, RadialGradient)):
+        red, green, blue, _ = background.rgba
+        return ParsedSvg(
+            geometry.pixel_width, geometry.pixel_height, (red, green, blue), scene.paths, background
+        )
+    return ParsedSvg(geometry.pixel_width, geometry.pixel_height, background, scene.paths)
 
 
 # ---------------------------------------------------------------------- XML and canvas
@@ -431,7 +442,7 @@ def _parse_with_svgelements(root: ElementTree.Element, geometry: _Geometry) -> A
 class _Scene:
     geometry: _Geometry
     ids: dict[str, ElementTree.Element] = field(default_factory=dict)
-    background: tuple[float, float, float] | None = None
+    background: tuple[float, float, float] | _Gradient | None = None
     paths: list[tuple[np.ndarray, _Fill]] = field(default_factory=list)
 
 
@@ -502,11 +513,10 @@ def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
         isinstance(shape, svgelements.Rect)
         and not scene.paths
         and scene.background is None
-        and isinstance(fill, tuple)
-        and fill[3] >= 1.0
+        and (fill[3] >= 1.0 if isinstance(fill, tuple) else fill.opaque)
         and _covers_canvas(points, scene.geometry)
     ):
-        scene.background = fill[:3]
+        scene.background = (fill[0], fill[1], fill[2]) if isinstance(fill, tuple) else fill
         return
     scene.paths.append((points, fill))
 

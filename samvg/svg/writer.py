@@ -1,7 +1,8 @@
 """SVG text of a `Scene`: width, height and viewBox, an optional background rectangle, and one
 ``<path>`` of absolute cubic commands per path, coordinates rounded to a fixed precision. A
 gradient fill is a ``<linearGradient>`` or ``<radialGradient>`` (userSpaceOnUse) in ``<defs>``,
-one id per path (``g<path number>``), referenced by ``fill="url(#…)"``.
+one id per path (``g<path number>``), referenced by ``fill="url(#…)"``; a background gradient
+is the background rectangle's fill, id ``bg``.
 
 Written by hand: the output is a dozen lines of fixed shape, and its bytes must not depend on
 a library's formatting choices (tests compare them).
@@ -71,12 +72,14 @@ def scene_to_svg(scene: Scene, precision: int = 2) -> str:
         f'<svg xmlns="{SVG_NAMESPACE}" width="{scene.width}" height="{scene.height}" '
         f'viewBox="0 0 {scene.width} {scene.height}">'
     ]
+    definitions: list[str] = []
     if scene.background is not None:
-        lines.append(
-            f'<rect width="{scene.width}" height="{scene.height}" '
-            f'fill="{hex_colour(scene.background)}"/>'
-        )
-    definitions = [
+        fill = hex_colour(scene.background)
+        if scene.background_gradient is not None:
+            definitions.append(gradient_element(scene.background_gradient, "bg", precision))
+            fill = "url(#bg)"
+        lines.append(f'<rect width="{scene.width}" height="{scene.height}" fill="{fill}"/>')
+    definitions += [
         gradient_element(paint, f"g{index}", precision)
         for index, paint in enumerate(scene.paints)
         if not isinstance(paint, FlatPaint)

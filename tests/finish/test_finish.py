@@ -84,3 +84,14 @@ def test_a_finished_scene_finishes_unchanged():
     assert second.counts["hidden_removed"] == 0
     assert all(is_simple(points) for points, _ in second.scene.paths())
     assert second.scene.path_count == first.path_count - second.counts["merged"]
+
+
+def test_the_finish_keeps_a_background_gradient():
+    from dataclasses import replace
+
+    from samvg.scene import RadialGradient
+
+    glow = RadialGradient(((0.0, (1, 1, 0)), (1.0, (0, 0, 1))), 1.0, (256.0, 256.0), 300.0)
+    scene = replace(tangled_scene(20, seed=2), background_gradient=glow)
+    result = finish_scene(scene, FinishSettings(colours=3)).scene
+    assert result.background_gradient == glow and result.background == scene.background

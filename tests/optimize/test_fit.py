@@ -133,3 +133,50 @@ def test_a_fit_stops_once_its_loss_stops_improving():
     assert 50 <= len(result.losses) < 600 and steps[-1] == 599  # progress completes
     assert np.abs(result.scene.render() - target).mean() < 0.01
     assert len(fit_scene(start, target, FitSettings(steps=60)).losses) == 60
+
+
+def test_a_background_gradient_is_fitted_with_the_paths():
+    from samvg.scene import LinearGradient, RadialGradient
+
+    _, cols = np.mgrid[:32, :40]
+    along = (cols + 0.5) / 40
+    target = np.stack([0.9 - 0.8 * along, 0.2 + 0 * along, 0.1 + 0.8 * along], axis=2)
+    target[8:20, 10:22] = (0.1, 0.6, 0.2)  # one flat square on the ramp
+    grey = ((0.0, (0.5, 0.5, 0.5)), (1.0, (0.4, 0.4, 0.4)))
+    settings = FitSettings(steps=150, point_learning_rate=0.3, colour_learning_rate=0.02)
+    path = [(square(11, 9, 10), FlatPaint((0.3, 0.3, 0.3)))]
+    for guess, paths, most in (
+        (LinearGradient(grey, 1.0, (10.0, 4.0), (30.0, 20.0)), path, 1e-5),  # exact
+        (RadialGradient(grey, 1.0, (20.0, 16.0), 20.0), path, 3e-3),  # the best it can
+        (LinearGradient(grey, 1.0, (10.0, 4.0), (30.0, 20.0)), [], 0.02),  # no path: the square
+    ):
+        start = Scene.from_paths(40, 32, paths, background_gradient=guess)
+        result = fit_scene(start, target, settings)
+        fitted = result.scene.background_gradient
+        assert type(fitted) is type(guess) and fitted.opacity == 1.0
+        offsets = [offset for offset, _ in fitted.stops]
+        assert offsets == sorted(offsets) and offsets[0] >= 0.0 and offsets[-1] <= 1.0
+        assert np.mean((start.render() - target) ** 2) > 0.05
+        assert np.mean((result.scene.render() - target) ** 2) < most
+        assert len(result.losses) == 150
+
+
+def test_a_fit_over_an_underlay_leaves_the_background_gradient_alone():
+    from samvg.scene import LinearGradient
+
+    ramp = LinearGradient(((0.0, (1, 0, 0)), (1.0, (0, 0, 1))), 1.0, (0.0, 0.0), (32.0, 0.0))
+    scene = Scene.from_paths(32, 32, [(square(4, 4, 10), FlatPaint((0.5, 0.5, 0.5)))],
+                             background_gradient=ramp)  # fmt: skip
+    target = np.full((32, 32, 3), 0.2)
+    result = fit_scene(scene, target, FitSettings(steps=5), underlay=np.ones((32, 32, 3)))
+    assert result.scene.background_gradient == ramp
+
+
+def test_the_gradient_choice_gives_a_ramp_background_a_gradient_before_fitting():
+    rows, cols = np.mgrid[:32, :32]
+    ramp = ((cols + 0.5) / 32)[:, :, None].repeat(3, axis=2)
+    start = Scene.from_paths(32, 32, [(square(4, 4, 5), FlatPaint((0.5, 0.5, 0.5)))],
+                             background=(0.5, 0.5, 0.5))  # fmt: skip
+    result = fit_scene(start, ramp, FitSettings(steps=20, gradient_cost=1e-6))
+    assert result.scene.background_gradient is not None
+    assert np.mean((result.scene.render() - ramp) ** 2) < 1e-3

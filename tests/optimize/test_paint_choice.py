@@ -56,3 +56,34 @@ def test_flat_areas_and_costly_gradients_stay_flat():
     assert choose_gradients(covering_scene(), ramp, cost=1.0)[1] == 0
     with pytest.raises(InputError, match="does not match"):
         choose_gradients(covering_scene(), ramp[:10])
+
+
+def test_a_ramp_behind_the_paths_gives_the_background_a_linear_gradient():
+    x, _ = grid()
+    ramp = np.stack([x / SIZE, 0.3 + 0 * x, 1 - x / SIZE], axis=2).astype(np.float32)
+    small = [(square(40, 40, 5), FlatPaint((0, 0, 0)))]  # too few pixels for a gradient
+    for paths in ([], small):
+        scene = Scene.from_paths(SIZE, SIZE, paths, background=(0.5, 0.3, 0.5))
+        chosen, switched = choose_gradients(scene, ramp)
+        assert isinstance(chosen.background_gradient, LinearGradient) and switched == 1
+        start, end = chosen.background_gradient.start, chosen.background_gradient.end
+        assert abs(end[0] - start[0]) > 40 and abs(end[1] - start[1]) < 1  # horizontal
+        shown = shown_labels(scene) == -1
+        error = np.mean((chosen.render() - ramp)[shown] ** 2)
+        assert error < np.mean((scene.render() - ramp)[shown] ** 2) / 100
+        assert chosen.paints == scene.paints  # the small black path stays flat
+        again, switched = choose_gradients(chosen, ramp)  # a gradient is not offered again
+        assert again is chosen and switched == 0
+
+
+def test_a_uniform_background_and_no_background_stay_as_they_are():
+    uniform = np.full((SIZE, SIZE, 3), 0.4, np.float32)
+    scene = Scene(SIZE, SIZE, background=(0.4, 0.4, 0.4))
+    assert choose_gradients(scene, uniform) == (scene, 0)
+    x, _ = grid()
+    ramp = (x / SIZE)[:, :, None].repeat(3, axis=2).astype(np.float32)
+    assert choose_gradients(Scene(SIZE, SIZE), ramp)[1] == 0  # no background: transparent
+    assert choose_gradients(scene, ramp, background=False)[1] == 0
+    assert choose_gradients(scene, ramp, cost=1.0)[1] == 0
+    hidden = covering_scene().with_paths([(square(-1, -1, 66), FlatPaint((0, 0, 0)))])
+    assert choose_gradients(hidden, ramp)[0].background_gradient is None  # none shows

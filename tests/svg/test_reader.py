@@ -654,3 +654,27 @@ def test_gradient_fills_read_back_in_canvas_pixels():
     # rotate(90) maps (5, 5) to (-5, 5), translate(1 1) to (-4, 6): (-8, 12) in pixels
     assert radial.centre == pytest.approx((-8, 12)) and radial.radius == pytest.approx(4)
     assert [offset for offset, _ in radial.stops] == [0.2, 0.2]  # offsets never fall
+
+
+@pytest.mark.parametrize(("opacity", "is_background"), [("1", True), ("0.5", False)])
+def test_a_full_canvas_rect_with_an_opaque_gradient_is_a_gradient_background(
+    opacity, is_background
+):
+    text = (
+        '<svg xmlns="http://www.w3.org/2000/svg" width="20" height="10" viewBox="0 0 10 5">'
+        '<rect width="10" height="5" fill="url(#bg)" fill-opacity="' + opacity + '"/>'
+        '<defs><radialGradient id="bg" gradientUnits="userSpaceOnUse" cx="5" cy="2" r="4">'
+        '<stop offset="0" stop-color="#ff0000"/><stop offset="1" stop-color="#0000ff"/>'
+        "</radialGradient></defs>"
+        f'<path {TRIANGLE} fill="#00ff00"/>'
+        "</svg>"
+    )
+    parsed = read_svg(text)
+    if not is_background:
+        assert parsed.background_gradient is None and parsed.background is None
+        assert len(parsed.paths) == 2 and isinstance(parsed.paths[0][1], RadialGradient)
+        return
+    gradient = parsed.background_gradient
+    assert isinstance(gradient, RadialGradient) and len(parsed.paths) == 1
+    assert gradient.centre == pytest.approx((10, 4)) and gradient.radius == pytest.approx(8)
+    assert parsed.background == pytest.approx((0.5, 0.0, 0.5))  # the mean stop colour
