@@ -88,7 +88,9 @@ def measure(record: dict[str, Any], entry: dict[str, str], lpips: Any) -> dict[s
     return record
 
 
-def run_study(old: str, per_category: int, presets: list[str]) -> None:
+def run_study(
+    old: str, per_category: int, presets: list[str], keep_svg: Path | None = None
+) -> None:
     sys.path.insert(0, str(REPO / "benchmarks"))
     from bench_images import BENCH, bench_entries
 
@@ -108,7 +110,12 @@ def run_study(old: str, per_category: int, presets: list[str]) -> None:
                         if path.exists():
                             continue
                         image = BENCH / entry["png"]
-                        record = measure(run_tree(tree, image, preset), entry, lpips)
+                        record = run_tree(tree, image, preset)
+                        if keep_svg is not None:  # for contact_sheet.py --svg-dir
+                            keep_svg.mkdir(parents=True, exist_ok=True)
+                            tag = f"{label.split('-')[0]}-{preset}"
+                            (keep_svg / f"{entry['id']}.{tag}.svg").write_text(record["svg"])
+                        record = measure(record, entry, lpips)
                         record.update(id=entry["id"], category=entry["category"], preset=preset)
                         path.parent.mkdir(parents=True, exist_ok=True)
                         atomic_write_text(path, json.dumps(record, indent=1))
@@ -242,9 +249,11 @@ def main() -> None:
     parser.add_argument("--old", required=True, help="the commit to compare with")
     parser.add_argument("--per-category", type=int, default=4)
     parser.add_argument("--presets", default="default,fast")
+    parser.add_argument("--keep-svg", type=Path, help="also write every run's SVG to this folder")
     arguments = parser.parse_args()
     if arguments.study == "run":
-        run_study(arguments.old, arguments.per_category, arguments.presets.split(","))
+        presets = arguments.presets.split(",")
+        run_study(arguments.old, arguments.per_category, presets, arguments.keep_svg)
     write_report(arguments.old)
 
 
