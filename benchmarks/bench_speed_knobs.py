@@ -32,6 +32,7 @@ import samvg
 from samvg.config import FitOptions
 from samvg.metrics import load_lpips, lpips_distance
 from samvg.optimize import FitSettings, fit_scene
+from samvg.scene import FlatPaint
 
 RESULTS = REPO / "benchmarks/results/speed_knobs"
 GEOMETRY = REPO / "benchmarks/results/geometry"
@@ -80,6 +81,7 @@ def summary(rows: dict[str, list[tuple[float, ...]]], log: Log) -> None:
             f"SUMMARY {name}: mean MSE {values[:, 0].mean() * 1e3:.3f}e-3, mean LPIPS "
             f"{values[:, 1].mean():.4f}, seconds {values[:, 2].sum():.1f}; geometric-mean ratio "
             f"to {names[0]}: MSE {ratio[0]:.3f}, LPIPS {ratio[1]:.3f}"
+            + (f"; mean parameters {values[:, 3].mean():.0f}" if values.shape[1] > 3 else "")
         )
 
 
@@ -96,9 +98,13 @@ def fit_study(chosen: dict[str, dict[str, Any]], log: Log) -> None:
             seconds = time.perf_counter() - started
             picture = np.clip(fitted.render(), 0, 1)
             mse = float(np.mean((picture - target) ** 2))
-            rows[name].append((mse, lpips_distance(lpips, picture, target), seconds))
-            log(f"{entry['id'][:28]:28} {name:10} MSE {mse * 1e3:7.3f}e-3 "
-                f"LPIPS {rows[name][-1][1]:.4f} {seconds:5.1f} s")  # fmt: skip
+            shaded = sum(not isinstance(paint, FlatPaint) for paint in fitted.paints)
+            shaded += fitted.background_gradient is not None
+            distance = lpips_distance(lpips, picture, target)
+            rows[name].append((mse, distance, seconds, fitted.parameter_count))
+            log(f"{entry['id'][:28]:28} {name:10} MSE {mse * 1e3:7.3f}e-3 LPIPS {distance:.4f} "
+                f"{seconds:5.1f} s, {fitted.parameter_count} parameters, "
+                f"{shaded} gradients")  # fmt: skip
     summary(rows, log)
 
 
