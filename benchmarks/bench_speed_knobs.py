@@ -63,7 +63,7 @@ def traced_scene(entry: dict[str, str]) -> tuple[samvg.Scene, np.ndarray]:
     if cache.exists():
         with cache.open("rb") as handle:
             return pickle.load(handle)
-    config = samvg.Config(missing_rounds=0, finish_pass=False, iterations=0)
+    config = samvg.Config(missing_rounds=0, finish_pass=False, iterations=0, gradients=False)
     result = samvg.run(BENCH / entry["png"], config)
     cache.parent.mkdir(parents=True, exist_ok=True)
     with cache.open("wb") as handle:
