@@ -428,13 +428,17 @@ def render_array(
     return image.numpy().astype(np.float32, copy=False)
 
 
+def _scaled_size(scene: Scene, scale: float) -> tuple[int, int]:
+    """(width, height) of the scene's canvas drawn at ``scale``, at least one pixel each."""
+    return max(1, round(scene.width * scale)), max(1, round(scene.height * scale))
+
+
 def background_image(scene: Scene, scale: float = 1.0) -> np.ndarray | None:
     """The float64 (H, W, 3) image of the scene's background gradient at ``scale`` × its canvas
     size (None when its background is flat)."""
     if scene.background_gradient is None:
         return None
-    width = max(1, round(scene.width * scale))
-    height = max(1, round(scene.height * scale))
+    width, height = _scaled_size(scene, scale)
     with torch.no_grad():
         paint = GradientPaints.of([scene.background_gradient], scale)
         return paint.image(0, width, height).numpy()
@@ -445,8 +449,7 @@ def render_scene(scene: Scene, scale: float = 1.0) -> np.ndarray:
     background meaning white."""
     if not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
         raise InputError(f"render scale must be a positive number, got {scale}")
-    width = max(1, round(scene.width * scale))
-    height = max(1, round(scene.height * scale))
+    width, height = _scaled_size(scene, scale)
     image = background_image(scene, scale)
     return render_array(
         scene.points * scale,
