@@ -135,6 +135,10 @@ class FitOptions:
 
     iterations: int = 500
     """Adam steps per optimization phase (after tracing, and again after each stage-4 round)."""
+    draft_iterations: int = 200
+    """Steps of stage 3's fit when stage 4 fits the whole scene once at its end (``refit_scene``
+    off, the default): a draft on MSE + Xing, half of it at half size, that only has to place
+    the paths well enough for stage 4's error map; the fit at the end has ``iterations`` steps."""
     point_learning_rate: float = 1.0
     colour_learning_rate: float = 0.01
     xing_weight: float = 0.01
@@ -166,6 +170,7 @@ class FitOptions:
 
     def __post_init__(self) -> None:
         _check_integer(self, "iterations", 0)
+        _check_integer(self, "draft_iterations", 0)
         if self.margin is not None:
             _check_non_negative(self, "margin")
         _check_integer(self, "lpips_size", 32)

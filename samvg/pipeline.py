@@ -240,11 +240,13 @@ def _run_stages(
     segmenter, masks = _segment(inputs, config, result, report)
     trace_settings = TraceSettings.from_config(config, width, height)
     scene = _trace(masks, inputs, trace_settings, config, result, report)
-    with _timed(result, "optimize"):
-        on_step = _progress_of(report, "optimize", fit.steps)
-        scene = fit_scene(scene, inputs.target, fit, on_step).scene
-    result.optimized = VectorImage.from_scene(scene)
     missing = MissingSettings.from_config(config, width, height)
+    drafted = missing.rounds != 0 and not missing.refit_scene  # the end fits the whole scene
+    first = fit.draft(min(config.fit.draft_iterations, fit.steps)) if drafted else fit
+    with _timed(result, "optimize"):
+        on_step = _progress_of(report, "optimize", first.steps)
+        scene = fit_scene(scene, inputs.target, first, on_step).scene
+    result.optimized = VectorImage.from_scene(scene)
     if missing.rounds != 0 and config.trace.adaptive and config.trace.reshape:
         with _timed(result, "reshape"):
             scene, counts = reshape_scene(
@@ -252,7 +254,7 @@ def _run_stages(
             )
         result.counts.update(counts)
     stages = (missing, trace_settings, fit)
-    scene, fitted = _add_missing(scene, inputs, segmenter, stages, config, result, report)
+    scene, fitted = _add_missing(scene, inputs, segmenter, stages, config, result, report, drafted)
     budget = config.missing.paths
     if budget is not None and config.finish.finish_pass:
         scene = _finish_pass(scene, config, inputs, result, report)  # merges and hidden go first
@@ -345,10 +347,12 @@ def _add_missing(
     config: Config,
     result: PipelineResult,
     report: ProgressCallback,
+    drafted: bool = False,
 ) -> tuple[Scene, bool]:
     """Stage 4: as many rounds as asked, as ``detail`` decides, or until a path budget's pool is
     full. Returns the scene and whether it was fitted as a whole after its last paths came
-    (under a budget it is not: the fit after the cut does it)."""
+    (under a budget it is not: the fit after the cut does it). ``drafted``: stage 3's fit was a
+    draft, so the scene is fitted in full even when no round adds a path."""
     budget = config.missing.paths
     pool = math.ceil(BUDGET_POOL * budget) if budget is not None else None
     planned = settings[0].rounds
@@ -364,6 +368,7 @@ def _add_missing(
         alpha=inputs.alpha,
         on_step=_progress_of(report, "refine", settings[2].steps),
         fit_at_end=budget is None,  # under a budget, the fit after the cut is the whole fit
+        drafted=drafted,
     )
     report("missing", total, total)
     result.missing_map, result.missing_prompts = done.error_map, done.prompts

@@ -200,13 +200,15 @@ def add_missing_rounds(
     alpha: np.ndarray | None = None,
     on_step: StepCallback | None = None,
     fit_at_end: bool = True,
+    drafted: bool = False,
 ) -> MissingRounds:
     """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
     less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`). With a ``pool`` (a path
     budget), rounds take the candidates of largest impact, however small, until the scene has
     ``pool`` paths or a round finds nothing more (at most ``2 * MAX_AUTO_ROUNDS``). Unless
     ``settings.refit_scene``, rounds fit only the paths they add and the whole scene is fitted
-    once at the end (with ``fit_at_end``; else ``fitted`` is False and the caller fits it)."""
+    once at the end (with ``fit_at_end``; else ``fitted`` is False and the caller fits it), also
+    when no round added a path to a ``drafted`` scene (one given a draft fit only)."""
     settings, trace, fit = stages
     full_at = None
     if pool is not None:
@@ -241,7 +243,7 @@ def add_missing_rounds(
         if planned is None and pool is None and gain < settings.gain_tolerance:
             done.stopped = f"round {done.rounds} lowered the error by {gain:.1%}"
             break
-    done.fitted = settings.refit_scene or not done.added
+    done.fitted = settings.refit_scene or not (done.added or drafted)
     if not done.fitted and fit_at_end:
         clock = time.perf_counter()
         scene = fit_scene(scene, target, fit, on_step).scene

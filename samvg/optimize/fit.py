@@ -99,6 +99,13 @@ class FitSettings:
     def with_steps(self, steps: int) -> FitSettings:
         return replace(self, steps=steps)
 
+    def draft(self, steps: int) -> FitSettings:
+        """A cheaper fit of ``steps`` steps on MSE + Xing, half of them at half size, for a
+        scene that is fitted again in full later."""
+        return replace(
+            self, steps=steps, perceptual=None, perceptual_weight=0.0, coarse_fraction=0.5
+        )
+
 
 def margin_box(canvas: tuple[int, int], fraction: float) -> tuple[float, float, float, float]:
     """The (width, height) canvas grown by ``fraction`` of its longer side on every side, as

@@ -99,3 +99,23 @@ def test_rounds_fit_only_what_they_add_then_the_whole_scene_once():
         misplaced, target(), SilentSegmenter(), refit, on_step=lambda s, _: steps.append(s)
     )
     assert steps.count(0) == 1  # the paper's round fits the whole scene, once
+
+
+def test_a_drafted_scene_is_fitted_in_full_even_when_no_round_adds_a_path():
+    from dataclasses import replace
+
+    from samvg.scene import FlatPaint
+    from tests.paths import square
+
+    image = np.ones((64, 64, 3), np.float32)
+    image[6:26, 6:26] = RED
+    drafted = Scene.from_paths(64, 64, [(square(4, 4, 20), FlatPaint(RED))], (1.0, 1.0, 1.0))
+    stages = (replace(settings(), refit_scene=False), STAGES[1], FitSettings(steps=40))
+    kept = add_missing_rounds(drafted, image, SilentSegmenter(), stages)
+    assert kept.added == 0 and kept.fitted
+    assert np.allclose(kept.scene.points, drafted.points)  # fitted before: left alone
+    refitted = add_missing_rounds(drafted, image, SilentSegmenter(), stages, drafted=True)
+    assert refitted.added == 0 and refitted.fitted
+    assert not np.allclose(refitted.scene.points, drafted.points)
+    error = np.mean((refitted.scene.render() - image) ** 2)
+    assert error < np.mean((drafted.render() - image) ** 2)
