@@ -93,6 +93,7 @@ class FastDecoder:
         if image_embedding.dim() != 4 or image_embedding.shape[0] != 1:
             raise ValueError("FastDecoder expects one image embedding (1, C, H, W)")
         self.model = model
+        self._cropped_yt: tuple[tuple[int, int], torch.Tensor] | None = None
         md = model.mask_decoder
         tr = md.transformer
         if tr.depth != 2:
@@ -395,7 +396,9 @@ class FastDecoder:
                 return x.reshape(*x.shape[:-1], gy, gx)[..., :gh, :gw].reshape(*x.shape[:-1], nv)
 
             d, s1, s2 = crop(state.d), crop(state.s1), crop(state.s2)
-            yt = crop(self.yt.t()).t()
+            if self._cropped_yt is None or self._cropped_yt[0] != (gh, gw):
+                self._cropped_yt = ((gh, gw), crop(self.yt.t()).t())
+            yt = self._cropped_yt[1]
         vt12 = torch.cat([state.vt1, state.vt2], dim=1)
         rt = self._basis_rows(vt12, self.mt)  # (B, r+1, 4*C4)
         x = torch.baddbmm(yt.unsqueeze(0) * s1[:, :, None], d.transpose(1, 2), rt)
