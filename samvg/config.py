@@ -136,9 +136,10 @@ class FitOptions:
     iterations: int = 500
     """Adam steps per optimization phase (after tracing, and again after each stage-4 round)."""
     draft_iterations: int = 200
-    """Steps of stage 3's fit when stage 4 fits the whole scene once at its end (``refit_scene``
-    off, the default): a draft on MSE + Xing, half of it at half size, that only has to place
-    the paths well enough for stage 4's error map; the fit at the end has ``iterations`` steps."""
+    """Steps of the draft fits when stage 4 fits the whole scene once at its end (``refit_scene``
+    off, the default): stage 3's fit and each round's fit of its new paths run this many steps
+    (at most ``iterations``) on MSE + Xing, half of them at half size; they only have to place
+    the paths for the next error map. The fit at the end has ``iterations`` steps."""
     point_learning_rate: float = 1.0
     colour_learning_rate: float = 0.01
     xing_weight: float = 0.01

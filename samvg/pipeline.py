@@ -242,7 +242,7 @@ def _run_stages(
     scene = _trace(masks, inputs, trace_settings, config, result, report)
     missing = MissingSettings.from_config(config, width, height)
     drafted = missing.rounds != 0 and not missing.refit_scene  # the end fits the whole scene
-    first = fit.draft(min(config.fit.draft_iterations, fit.steps)) if drafted else fit
+    first = fit.draft() if drafted else fit
     with _timed(result, "optimize"):
         on_step = _progress_of(report, "optimize", first.steps)
         scene = fit_scene(scene, inputs.target, first, on_step).scene

@@ -167,7 +167,7 @@ def add_missing(
         if settings.refit_scene:
             result.scene = fit_scene(scene.stacked(added), target, fit, on_step).scene
         else:
-            alone = replace(fit, perceptual=None, perceptual_weight=0.0)  # LPIPS comes at the end
+            alone = fit.draft()  # the whole fit at the end polishes these paths with the rest
             result.scene = scene.stacked(fit_scene(added, target, alone, on_step, render).scene)
         result.timings["refine"] = time.perf_counter() - clock
     return result

@@ -59,6 +59,9 @@ class FitSettings:
     plateau_steps: int | None = None
     """Stop a phase (each size of it) once its loss has stopped improving over this many steps
     (None: always run every step)."""
+    draft_steps: int | None = None
+    """Steps of a draft fit (`draft`), one whose scene is fitted again in full later (None:
+    ``steps``)."""
     gradient_cost: float | None = None
     """Offer every flat path, and a flat background, a gradient fill before fitting
     (`samvg.optimize.paint_choice`), bought when it removes this much MSE per added parameter;
@@ -94,16 +97,21 @@ class FitSettings:
             coarse_fraction=options.coarse_fraction,
             plateau_steps=options.plateau_steps,
             gradient_cost=options.gradient_cost if options.gradients else None,
+            draft_steps=min(options.draft_iterations, options.iterations),
         )
 
     def with_steps(self, steps: int) -> FitSettings:
         return replace(self, steps=steps)
 
-    def draft(self, steps: int) -> FitSettings:
-        """A cheaper fit of ``steps`` steps on MSE + Xing, half of them at half size, for a
+    def draft(self) -> FitSettings:
+        """A cheaper fit, ``draft_steps`` steps on MSE + Xing, half of them at half size, for a
         scene that is fitted again in full later."""
         return replace(
-            self, steps=steps, perceptual=None, perceptual_weight=0.0, coarse_fraction=0.5
+            self,
+            steps=self.steps if self.draft_steps is None else self.draft_steps,
+            perceptual=None,
+            perceptual_weight=0.0,
+            coarse_fraction=0.5,
         )
 
 
