@@ -14,6 +14,7 @@ import torch
 from samvg.config import FitOptions
 from samvg.errors import InputError, SamvgError
 from samvg.imaging import halve
+from samvg.optimize.adam import Adam
 from samvg.optimize.losses import PerceptualLoss, lpips_loss, segment_indices, xing_loss
 from samvg.optimize.paint_choice import choose_gradients
 from samvg.render import rasterize
@@ -210,17 +211,17 @@ class _Parameters:
         """Whether there is anything to fit: a path or a background gradient."""
         return self.scene.path_count > 0 or self.background is not None
 
-    def optimizer(self, settings: FitSettings) -> torch.optim.Adam:
+    def optimizer(self, settings: FitSettings) -> Adam:
         point_group = [self.points]
         colour_group = [self.colours]
         for variables in (self.gradients, self.background):
             if variables is not None:
                 point_group.append(variables.geometry)
                 colour_group.append(variables.values)
-        return torch.optim.Adam(
+        return Adam(
             [
-                {"params": point_group, "lr": settings.point_learning_rate},
-                {"params": colour_group, "lr": settings.colour_learning_rate},
+                (point_group, settings.point_learning_rate),
+                (colour_group, settings.colour_learning_rate),
             ]
         )
 
@@ -358,7 +359,7 @@ def _fit_level(
         objective = _Objective(target, settings, segment_indices(scene.offsets))
         with single_torch_thread():
             for step in range(settings.steps):
-                optimizer.zero_grad(set_to_none=True)
+                optimizer.zero_grad()
                 loss, reported = objective(parameters.render(), parameters.points, step)
                 loss.backward()
                 optimizer.step()
