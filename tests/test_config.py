@@ -26,7 +26,7 @@ def test_presets_and_replace():
     assert Config.paper() != Config() and Config.paper().trace.segments == 5
     assert Config().trace.segments is None and not Config().fit.translucent
     fast = Config.fast(seed=3)
-    assert fast.segment.points_per_side == 16 and not fast.fit.use_lpips and fast.seed == 3
+    assert fast.segment.points_per_side == 8 and not fast.fit.use_lpips and fast.seed == 3
     changed = fast.replace(iterations=7, size=64)
     assert changed.fit.iterations == 7 and changed.size == 64
     assert changed.segment == fast.segment and fast.fit.iterations == 120
