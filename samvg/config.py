@@ -58,8 +58,8 @@ class SegmentOptions:
     checkpoint: str | None = None
     points_per_side: int = 16
     """SAM's automatic grid: this many points a side (the paper: 32). Stage 4's rounds and the
-    colour parts find what a coarser grid misses; on 21 bench images 16 beat 32 on MSE and
-    LPIPS, a third faster (benchmarks/results/speed.md)."""
+    colour parts find what a coarser grid misses; on 24 bench images 16 beat 32 on MSE and
+    LPIPS (x0.92 each), a third faster (benchmarks/results/speed.md)."""
     crop_n_layers: int = 0
     """SAM's test-time augmentation: layers of zoomed, overlapping crops (0 = off)."""
     filter_by_impact: bool = True
