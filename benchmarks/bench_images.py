@@ -65,10 +65,13 @@ def working_image(entry: dict[str, str], size: int = 512) -> tuple[np.ndarray, f
 def render_at_working_size(
     image: samvg.VectorImage, scale: float, shape: tuple[int, ...]
 ) -> np.ndarray:
-    """An SVG in input pixels rendered at ``scale``, cropped to the working image's (H, W) and
+    """An SVG in input pixels rendered at ``scale``, cropped (or, where the working size rounded
+    up and the render's down, edge-padded by that pixel) to the working image's (H, W) and
     clipped to [0, 1]."""
     height, width = shape[:2]
-    return np.clip(image.render(scale=scale)[:height, :width], 0, 1)
+    picture = image.render(scale=scale)[:height, :width]
+    short = ((0, height - picture.shape[0]), (0, width - picture.shape[1]), (0, 0))
+    return np.clip(np.pad(picture, short, mode="edge"), 0, 1)
 
 
 def setting_value(text: str) -> Any:

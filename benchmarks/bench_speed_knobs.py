@@ -1,7 +1,7 @@
 """Speed knobs of the fit (issue 14) against their cost in quality, at two levels.
 
     python benchmarks/bench_speed_knobs.py fit  base= lp2=lpips_every:2 plat=plateau_steps:50
-    python benchmarks/bench_speed_knobs.py pipeline v6=refit_scene:true,plateau_steps:50
+    python benchmarks/bench_speed_knobs.py pipeline --per-category 4 g32=points_per_side:32 g16=
 
 ``fit``: stage 3 alone. Each of 12 bench images (2 per category) is segmented and traced once
 at the default (no stage 4, no finish pass; cached under ``benchmarks/results/speed_knobs/
@@ -9,9 +9,10 @@ scenes/``, which git ignores), then fitted with each variant of `FitOptions`; MS
 fitted scene, seconds, and the geometric mean of each variant's MSE and LPIPS ratios to the
 first variant's.
 
-``pipeline``: the whole default pipeline with `Config` overrides on the same 12 images, against
-the default's records of ``bench_geometry.py --settings default`` (same code path, so the old
-default reproduces them exactly).
+``pipeline``: the whole pipeline with `Config` overrides (``preset:fast`` starts from
+`Config.fast`) on 2 (``--per-category``) images per category; one JSON record per variant and
+image under ``benchmarks/results/speed_knobs/pipeline/<variant>/`` (a rerun skips what is there,
+so a long run resumes); ratios against the first variant.
 
 A variant is ``name=setting:value,setting:value`` (``name=`` alone: the default). Lines go to
 stdout and to ``benchmarks/results/speed_knobs/<study>.log``.
@@ -30,12 +31,12 @@ from bench_images import BENCH, REPO, bench_entries, run_samvg, setting_value
 
 import samvg
 from samvg.config import FitOptions
+from samvg.io import atomic_write_text
 from samvg.metrics import load_lpips, lpips_distance
 from samvg.optimize import FitSettings, fit_scene
 from samvg.scene import FlatPaint
 
 RESULTS = REPO / "benchmarks/results/speed_knobs"
-GEOMETRY = REPO / "benchmarks/results/geometry"
 
 
 def variants(arguments: list[str]) -> dict[str, dict[str, Any]]:
@@ -108,32 +109,53 @@ def fit_study(chosen: dict[str, dict[str, Any]], log: Log) -> None:
     summary(rows, log)
 
 
-def pipeline_study(chosen: dict[str, dict[str, Any]], log: Log) -> None:
+def pipeline_study(chosen: dict[str, dict[str, Any]], log: Log, per_category: int = 2) -> None:
+    """Each variant on the same images (``preset:fast`` starts from `Config.fast`); records under
+    ``pipeline/<variant>/`` (a rerun skips them); ratios against the first variant."""
     lpips = load_lpips()
-    for name, overrides in chosen.items():
-        rows: dict[str, list[tuple[float, ...]]] = {"default records": [], name: []}
-        for entry in bench_entries(2):
-            run = run_samvg(entry, samvg.Config(**overrides))
-            picture = run.render()
-            mse = float(np.mean((picture - run.target) ** 2))
-            measured = (mse, lpips_distance(lpips, picture, run.target), run.seconds)
-            old = json.loads((GEOMETRY / f"{entry['id']}.default.json").read_text())
-            rows["default records"].append((old["mse"], old["lpips"], old["seconds"]))
-            rows[name].append(measured)
-            paths = run.result.counts.get("paths")
-            log(f"{name} {entry['id'][:26]:26} MSE {mse * 1e3:.3f}e-3 (default "
-                f"{old['mse'] * 1e3:.3f}) LPIPS {measured[1]:.4f} (default {old['lpips']:.4f}) "
-                f"paths {paths} ({old['paths']}) {run.seconds:.1f} s")  # fmt: skip
-        summary(rows, log)
+    rows: dict[str, list[tuple[float, ...]]] = {name: [] for name in chosen}
+    for entry in bench_entries(per_category):
+        for name, overrides in chosen.items():
+            path = RESULTS / "pipeline" / name / f"{entry['id']}.json"
+            if not path.exists():
+                settings = dict(overrides)
+                preset = samvg.Config.fast if settings.pop("preset", None) == "fast" else None
+                run = run_samvg(entry, (preset or samvg.Config)(**settings))
+                picture = run.render()
+                record = {
+                    "id": entry["id"],
+                    "mse": float(np.mean((picture - run.target) ** 2)),
+                    "lpips": lpips_distance(lpips, picture, run.target),
+                    "seconds": run.seconds,
+                    "paths": run.result.counts.get("paths"),
+                    "timings": run.result.timings,
+                }
+                path.parent.mkdir(parents=True, exist_ok=True)
+                atomic_write_text(path, json.dumps(record, indent=1))
+            record = json.loads(path.read_text())
+            rows[name].append((record["mse"], record["lpips"], record["seconds"]))
+            log(f"{name} {entry['id'][:26]:26} MSE {record['mse'] * 1e3:.3f}e-3 LPIPS "
+                f"{record['lpips']:.4f} paths {record['paths']} "
+                f"{record['seconds']:.1f} s")  # fmt: skip
+    summary(rows, log)
 
 
 def main() -> None:
-    if len(sys.argv) < 3 or sys.argv[1] not in ("fit", "pipeline"):
+    arguments = sys.argv[1:]
+    per_category = 2
+    if "--per-category" in arguments:
+        at = arguments.index("--per-category")
+        per_category = int(arguments[at + 1])
+        del arguments[at : at + 2]
+    if len(arguments) < 2 or arguments[0] not in ("fit", "pipeline"):
         raise SystemExit(__doc__)
-    study, chosen = sys.argv[1], variants(sys.argv[2:])
+    study, chosen = arguments[0], variants(arguments[1:])
     log = Log(study)
-    log(f"# {time.strftime('%Y-%m-%d %H:%M')} {study}: {' '.join(sys.argv[2:])}")
-    (fit_study if study == "fit" else pipeline_study)(chosen, log)
+    log(f"# {time.strftime('%Y-%m-%d %H:%M')} {study}: {' '.join(arguments[1:])}")
+    if study == "fit":
+        fit_study(chosen, log)
+    else:
+        pipeline_study(chosen, log, per_category)
 
 
 if __name__ == "__main__":
