@@ -1,9 +1,11 @@
 """`Config`: every setting of the vectorization pipeline, grouped by stage and checked once.
 
-Where the paper gives a value it is the default (32x32 AMG grid, 5 cubic segments per path, i.e.
-34 numbers per path with RGBA; Adam with learning rates 1 for points and 0.01 for colours; the
-missing-component threshold 0.784). Where it does not (impact threshold, kernel radii, loss
-weights) the value was chosen on ``../shared/bench`` with ``benchmarks/bench_vectorize.py``.
+`Config.paper()` is the paper's procedure (32x32 AMG grid, 5 cubic segments per path, i.e. 34
+numbers per path with RGBA, one stage-4 round, ...; see `PAPER`). The default keeps the paper's
+Adam learning rates (1 for points, 0.01 for colours) and missing-component threshold (0.784) and
+departs where a benchmark measured better (a 16x16 grid, segments per outline, draft fits until
+stage 4 ends; `benchmarks/results/`). Where the paper gives no value (impact threshold, kernel
+radii, loss weights) it was chosen on ``../shared/bench`` with ``benchmarks/bench_vectorize.py``.
 
 Settings here are in the user's terms (fractions of the image, counts); each stage turns its
 group into typed settings in working pixels once, when the canvas size is known.
