@@ -107,13 +107,16 @@ def vtracer_record(entry: dict[str, str], setting: tuple[int, int, int], lpips: 
     }
 
 
-def save(name: str, entry: dict[str, str], extra: dict[str, Any], make: Any, *args: Any) -> None:
-    """Run ``make(entry, *args)`` and keep its record, unless the record is there already."""
-    record_file = RECORDS / f"{entry['id']}.{name}.json"
+def save(
+    records: Path, name: str, entry: dict[str, str], extra: dict[str, Any], make: Any, *args: Any
+) -> None:
+    """Run ``make(entry, *args)`` and keep its record in the folder ``records``, unless the
+    record is there already."""
+    record_file = records / f"{entry['id']}.{name}.json"
     if record_file.exists():
         return
     record = {"id": entry["id"], "category": entry["category"], **extra, **make(entry, *args)}
-    RECORDS.mkdir(parents=True, exist_ok=True)
+    records.mkdir(parents=True, exist_ok=True)
     atomic_write_text(record_file, json.dumps(record, indent=1))
     print(json.dumps(record), flush=True)
 
@@ -124,6 +127,7 @@ def run_budget(
     methods: list[str],
     overrides: dict[str, Any],
     keep_svg: Path | None = None,
+    records: Path = RECORDS,
 ) -> None:
     lpips = load_lpips()
     for budget in budgets:
@@ -135,9 +139,11 @@ def run_budget(
                     config = samvg.Config(paths=budget, gradients=gradients, **overrides)
                     extra["overrides"] = overrides
                     record = samvg_record
-                    save(f"{method}.{budget}", entry, extra, record, config, lpips, keep_svg)
+                    name = f"{method}.{budget}"
+                    save(records, name, entry, extra, record, config, lpips, keep_svg)
                 else:
-                    save(f"{method}.{budget}", entry, extra, baseline_record, method, budget, lpips)
+                    name = f"{method}.{budget}"
+                    save(records, name, entry, extra, baseline_record, method, budget, lpips)
 
 
 def run_rate(
@@ -151,7 +157,7 @@ def run_rate(
         for setting in VTRACER_SWEEP:
             tag = "-".join(map(str, setting))
             extra = {"study": "rate", "method": "vtracer", "setting": tag}
-            save(f"rate.vtracer.{tag}", entry, extra, vtracer_record, setting, lpips)
+            save(RECORDS, f"rate.vtracer.{tag}", entry, extra, vtracer_record, setting, lpips)
         for budget in budgets:
             for method in ("samvg", "samvg-gradients"):
                 extra = {"study": "rate", "method": method, "setting": str(budget)}
@@ -159,7 +165,7 @@ def run_rate(
                 gradients = method == "samvg-gradients"
                 config = samvg.Config(paths=budget, gradients=gradients, **overrides)
                 name = f"rate.{method}.{budget}"
-                save(name, entry, extra, samvg_record, config, lpips, keep_svg)
+                save(RECORDS, name, entry, extra, samvg_record, config, lpips, keep_svg)
 
 
 def main() -> None:
@@ -177,6 +183,13 @@ def main() -> None:
         help="a samvg setting for every samvg run (kept in each record), e.g. plateau_steps=50",
     )
     parser.add_argument("--keep-svg", type=Path, help="also write samvg's SVGs to this folder")
+    parser.add_argument(
+        "--records",
+        type=Path,
+        default=RECORDS,
+        help="budget records' folder (bench_speed.py's time-against-paths plot reads "
+        "benchmarks/results/speed/paths)",
+    )
     arguments = parser.parse_args()
     overrides = dict(_setting(text) for text in arguments.set)
     if arguments.study == "report":
@@ -191,7 +204,7 @@ def main() -> None:
     budgets = [int(text) for text in arguments.paths.split(",")]
     if arguments.study == "budget":
         methods = arguments.methods.split(",")
-        run_budget(entries, budgets, methods, overrides, arguments.keep_svg)
+        run_budget(entries, budgets, methods, overrides, arguments.keep_svg, arguments.records)
     else:
         run_rate(entries, budgets, overrides, arguments.keep_svg)
 

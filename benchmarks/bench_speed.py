@@ -12,7 +12,8 @@ report gives medians and the median of the per-image ratios. Every run is one JS
 and LPIPS are measured by the working tree's code on both SVGs, rendered at the 512-px working
 size. The report goes to ``benchmarks/results/speed.md``, with a plot of time against path
 count (``speed_paths.png``) for samvg, random init (diffvg) and the LIVE-style baseline at fixed
-budgets, drawn from the records of ``bench_detail.py budget`` (which time every run).
+budgets, drawn from the records of ``bench_detail.py budget --records
+benchmarks/results/speed/paths`` (which time every run).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ REPO = Path(__file__).resolve().parents[1]
 RECORDS = REPO / "benchmarks/results/speed"
 REPORT = REPO / "benchmarks/results/speed.md"
 PLOT = REPO / "benchmarks/results/speed_paths.png"
-DETAIL = REPO / "benchmarks/results/detail"
+PATHS = REPO / "benchmarks/results/speed/paths"
 PLOTTED = ("samvg", "samvg-gradients", "diffvg", "live")
 PRESETS = ("default", "fast")
 STAGES = ("segment", "trace", "optimize", "reshape", "missing", "refine", "reduce", "finish")
@@ -197,9 +198,10 @@ def write_report(old_label: str) -> None:
 
 
 def _budget_seconds() -> dict[str, dict[int, list[float]]]:
-    """Seconds of every budget run of ``bench_detail.py``, by method and path budget."""
+    """Seconds of the budget runs of ``bench_detail.py budget --records
+    benchmarks/results/speed/paths``, by method and path budget."""
     seconds: dict[str, dict[int, list[float]]] = {}
-    for path in sorted(DETAIL.glob("*.json")):
+    for path in sorted(PATHS.glob("*.json")):
         record = json.loads(path.read_text())
         if record.get("study") == "budget" and record["method"] in PLOTTED:
             by_budget = seconds.setdefault(record["method"], {})
@@ -219,7 +221,12 @@ def _paths_section() -> list[str]:
 
     lines = [
         "",
-        "## Time against path count (median seconds per image, `bench_detail.py budget`)",
+        "## Time against path count (median seconds per image)",
+        "",
+        "`python benchmarks/bench_detail.py budget --records benchmarks/results/speed/paths "
+        "--per-category 1 --categories emoji,photo --paths 16,64,256 --methods "
+        "samvg-gradients,diffvg,live` (samvg-gradients is the default, gradient fills on; random "
+        "init and the LIVE-style baseline: 1000 steps with samvg's losses).",
         "",
         "| method | paths | images | median s |",
         "|---|---|---|---|",
