@@ -264,7 +264,7 @@ def _run_stages(
         scene = _finish_pass(scene, config, inputs, result, report)
     if budget is not None:
         scene = _meet_budget(scene, inputs, budget, result)
-    _finish(scene, inputs.target, result, simple=config.finish.finish_pass)
+    _finish(scene, inputs.target, result, config.finish.finish_pass, _path_limit(config))
 
 
 def _finish_pass(
@@ -425,11 +425,22 @@ def _within(scene: Scene, config: Config, by_area: bool = False) -> Scene:
     limit = config.segment.max_paths
     if limit is None or scene.path_count <= limit:
         return scene
-    if not by_area:
-        return scene.subset(range(limit))
+    return _largest(scene, limit) if by_area else scene.subset(range(limit))
+
+
+def _largest(scene: Scene, limit: int | None) -> Scene:
+    """``scene`` with at most ``limit`` paths (None: all): its largest ones, in paint order."""
+    if limit is None or scene.path_count <= limit:
+        return scene
     vertices, vertex_offsets = flatten_paths(scene.points, scene.offsets)
     areas = polygon_areas(vertices, vertex_offsets)
     return scene.subset(np.sort(np.argsort(-areas, kind="stable")[:limit]))
+
+
+def _path_limit(config: Config) -> int | None:
+    """The most paths the SVG may have: ``max_paths`` and a ``--paths`` budget, the smaller."""
+    limits = [n for n in (config.segment.max_paths, config.missing.paths) if n is not None]
+    return min(limits) if limits else None
 
 
 def _finish_note(counts: dict[str, int]) -> str:
@@ -454,10 +465,20 @@ def simple_when_saved(scene: Scene, precision: int = SAVE_PRECISION) -> Scene:
     return repaired.with_geometry(np.round(repaired.points, precision))
 
 
-def _finish(scene: Scene, target: np.ndarray, result: PipelineResult, simple: bool = False) -> None:
+def _finish(
+    scene: Scene,
+    target: np.ndarray,
+    result: PipelineResult,
+    simple: bool = False,
+    limit: int | None = None,
+) -> None:
+    """The result's scene and SVG. A path that rounding to the SVG's precision makes cross
+    itself is repaired (``simple``); parts that repair splits off beyond ``limit`` paths go,
+    smallest first, so a budget or a path limit still holds."""
     result.scene = scene
     output = scene.in_input_pixels()
-    result.image = VectorImage.from_scene(simple_when_saved(output) if simple else output)
+    saved = _largest(simple_when_saved(output), limit) if simple else output
+    result.image = VectorImage.from_scene(saved)
     result.mse = float(np.mean((scene.render() - target) ** 2))
     result.counts["paths"] = result.image.scene.path_count
     result.counts["gradient_fills"] = sum(

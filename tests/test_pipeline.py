@@ -230,3 +230,19 @@ def test_the_sample_keeps_its_stripes_at_least_as_well_as_vtracer(sam_checkpoint
     result = samvg.run(sample, Config.fast(checkpoint=str(sam_checkpoint)))
     assert result.mse <= 4.3e-3
     assert result.counts["colour_parts"] > 0 and result.counts["missing_rounds"] >= 2
+
+
+@pytest.mark.slow
+def test_parts_that_rounding_repairs_split_off_do_not_break_a_budget(
+    emoji, sam_checkpoint, monkeypatch
+):
+    """kodim01 at ``--paths 64`` wrote 65: a path that rounding to the SVG's precision made
+    cross itself was split by its repair after the budget had been met."""
+    import samvg.pipeline as pipeline
+
+    def split_one_more(scene, precision=2):
+        return scene.stacked(scene.subset([0]))  # one extra path, as a repair's split makes
+
+    monkeypatch.setattr(pipeline, "simple_when_saved", split_one_more)
+    result = samvg.run(emoji, Config(checkpoint=str(sam_checkpoint), paths=3, **QUICK))
+    assert len(result.image.paths) == result.counts["paths"] == 3
