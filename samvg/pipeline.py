@@ -472,14 +472,17 @@ def _finish(
     simple: bool = False,
     limit: int | None = None,
 ) -> None:
-    """The result's scene and SVG. A path that rounding to the SVG's precision makes cross
-    itself is repaired (``simple``); parts that repair splits off beyond ``limit`` paths go,
-    smallest first, so a budget or a path limit still holds."""
+    """The result's scene, SVG and MSE (of the SVG as written, at the working size). A path that
+    rounding to the SVG's precision makes cross itself is repaired (``simple``); parts that
+    repair splits off beyond ``limit`` paths go, smallest first, so a budget or a path limit
+    still holds."""
     result.scene = scene
     output = scene.in_input_pixels()
     saved = _largest(simple_when_saved(output), limit) if simple else output
     result.image = VectorImage.from_scene(saved)
-    result.mse = float(np.mean((scene.render() - target) ** 2))
+    scale = scene.frame.scale if scene.frame is not None else 1.0
+    written = saved.on_canvas(scene.width, scene.height, scale)  # the SVG at the working size
+    result.mse = float(np.mean((written.render() - target) ** 2))
     result.counts["paths"] = result.image.scene.path_count
     result.counts["gradient_fills"] = sum(
         not isinstance(paint, FlatPaint) for paint in result.image.scene.paints
