@@ -454,7 +454,9 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
     vectorize.add_argument("--seed", type=int, default=0, help="random seed, 0 to 2**32 - 1")
     vectorize.add_argument("--device", default="cpu", help="cpu (default), cuda, cuda:N or mps")
     vectorize.add_argument(
-        "--threads", type=int, help="torch threads for SAM (default: torch's; 1 on a busy machine)"
+        "--threads",
+        type=int,
+        help="threads for SAM and the rasterizer (default: every core; 1 on a busy machine)",
     )
     vectorize.add_argument(
         "--model",

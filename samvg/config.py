@@ -301,8 +301,10 @@ class Config:
     seed: int = 0
     device: str = "cpu"
     threads: int | None = None
-    """torch threads for SAM (None = torch's default). Fitting always runs on one thread: its
-    tensors are small, and a thread pool stalls whenever another process holds a core."""
+    """Threads for SAM (torch's) and for the rasterizer's kernels (None: torch's default, and
+    every core for the rasterizer). Fitting's torch work (LPIPS, losses) runs on one thread: its
+    tensors are small, and torch's pool stalls whenever another process holds a core. The
+    result does not depend on the rasterizer's thread count."""
 
     def __init__(
         self,

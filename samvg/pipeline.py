@@ -38,6 +38,7 @@ from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import margin_box
 from samvg.optimize.reduce import reduce_paths
 from samvg.optimize.reshape import reshape_scene
+from samvg.render.threads import using_render_threads
 from samvg.sam import SPECS
 from samvg.scene import FlatPaint, Frame, Scene
 from samvg.segment import Segmenter, SegmentSettings, select_masks
@@ -107,12 +108,15 @@ def _timed(result: PipelineResult, stage: str) -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def _torch_threads(threads: int | None) -> Iterator[None]:
+def _threads(threads: int | None) -> Iterator[None]:
+    """torch's threads (SAM) and the rasterizer's set to ``threads`` for the run (None: their
+    defaults), and set back after it."""
     previous = torch.get_num_threads()
     if threads is not None:
         torch.set_num_threads(threads)
     try:
-        yield
+        with using_render_threads(threads):
+            yield
     finally:
         torch.set_num_threads(previous)
 
@@ -135,7 +139,7 @@ def run(
     say = log or (lambda _text: None)
     started = time.perf_counter()
     check_device(config.device)
-    with _torch_threads(config.threads):
+    with _threads(config.threads):
         original, alpha = load_input(image)
         working, scale = resize_longest(original, config.size)
         target = to_float_rgb(working)

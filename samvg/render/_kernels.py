@@ -264,8 +264,10 @@ def _row_deposit(xa: float, xb: float, h: float, acc: np.ndarray, base: int, bw:
 @njit(cache=True, nogil=True)
 def _edge_deposit(
     x0: float, y0: float, x1: float, y1: float, bw: int, bh: int,
-    acc: np.ndarray, off: int, stride: int,
+    acc: np.ndarray, off: int, stride: int, rlo: int, rhi: int,
 ) -> None:  # fmt: skip
+    """Deposit edge (x0, y0) -> (x1, y1) in the box rows ``rlo`` to ``rhi`` (exclusive); a row's
+    deposits do not depend on which rows are asked for."""
     if y0 == y1:
         return
     ylo = min(y0, y1)
@@ -278,8 +280,8 @@ def _edge_deposit(
     dx = x1 - x0
     inv_dy = 1.0 / dy
     sgn = 1.0 if dy > 0.0 else -1.0
-    r0 = int(math.floor(ys))
-    r1 = int(math.ceil(ye))
+    r0 = max(int(math.floor(ys)), rlo)
+    r1 = min(int(math.ceil(ye)), rhi)
     for r in range(r0, r1):
         ya = max(ys, float(r))
         yb = min(ye, float(r + 1))
@@ -293,11 +295,12 @@ def _edge_deposit(
 @njit(cache=True, nogil=True)
 def _path_deposits(
     verts: np.ndarray, v0: int, v1: int, bx0: int, by0: int, bw: int, bh: int,
-    acc: np.ndarray, off: int,
+    acc: np.ndarray, off: int, rlo: int, rhi: int,
 ) -> None:  # fmt: skip
-    """Zero the box buffer of one path and deposit all its edges (before the row prefix sums)."""
+    """Zero box rows ``rlo`` to ``rhi`` of one path's buffer and deposit its edges there
+    (before the row prefix sums)."""
     stride = bw + 1
-    for i in range(off, off + bh * stride):
+    for i in range(off + rlo * stride, off + rhi * stride):
         acc[i] = 0.0
     n = v1 - v0
     for e in range(n):
@@ -312,7 +315,39 @@ def _path_deposits(
             acc,
             off,
             stride,
+            rlo,
+            rhi,
         )
+
+
+@njit(cache=True, nogil=True)
+def row_bands(box: np.ndarray, height: int, parts: int) -> np.ndarray:
+    """``parts + 1`` row boundaries that split the canvas into bands of about equal work (the
+    box pixels of all paths in each band; a band may be empty)."""
+    work = np.zeros(height + 1, np.float64)
+    for p in range(box.shape[0]):
+        if box[p, 2] > 0 and box[p, 3] > 0:
+            work[box[p, 1]] += box[p, 2] + 1
+            work[box[p, 1] + box[p, 3]] -= box[p, 2] + 1
+    row_work = np.empty(height, np.float64)
+    total = 0.0
+    running = 0.0
+    for y in range(height):
+        running += work[y]
+        row_work[y] = running + 1.0  # the background fill and the row itself
+        total += row_work[y]
+    bands = np.empty(parts + 1, np.int64)
+    bands[0] = 0
+    bands[parts] = height
+    done = 0.0
+    y = 0
+    for i in range(1, parts):
+        goal = total * i / parts
+        while y < height and done + row_work[y] <= goal:
+            done += row_work[y]
+            y += 1
+        bands[i] = max(y, bands[i - 1])
+    return bands
 
 
 @njit(cache=True, nogil=True)
@@ -320,10 +355,12 @@ def render_forward(
     verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray, off: np.ndarray,
     colors: np.ndarray, background: np.ndarray, canvas: np.ndarray, acc: np.ndarray,
     under: np.ndarray, keep: bool, kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
+    row0: int, row1: int,
 ) -> None:  # fmt: skip
-    """Coverage and straight-alpha "over" compositing, path by path in paint order, over the
-    opaque RGB ``background`` (3,); an empty ``background`` (0,) paints over ``canvas`` as
-    given (an image the caller filled it with).
+    """Coverage and straight-alpha "over" compositing of canvas rows ``row0`` to ``row1``
+    (exclusive), path by path in paint order, over the opaque RGB ``background`` (3,); an empty
+    ``background`` (0,) paints over ``canvas`` as given (an image the caller filled it with).
+    Every pixel's value is the same whichever band computes it, so bands can run on threads.
 
     A path whose ``kinds`` entry is not ``FLAT`` takes its RGB per pixel from its gradient paint
     (``samvg.render._paint_kernels``); its alpha is still ``colors[p, 3]``.
@@ -333,7 +370,7 @@ def render_forward(
     backward pass); without, ``acc`` is a scratch buffer of the largest box and ``under`` unused.
     """
     if background.shape[0] == 3:
-        for y in range(canvas.shape[0]):
+        for y in range(row0, row1):
             for x in range(canvas.shape[1]):
                 for ch in range(3):
                     canvas[y, x, ch] = background[ch]
@@ -342,19 +379,23 @@ def render_forward(
     for p in range(n_paths):
         bw = box[p, 2]
         bh = box[p, 3]
-        if bw <= 0 or bh <= 0:
+        by0 = box[p, 1]
+        rlo = max(0, row0 - by0)
+        rhi = min(bh, row1 - by0)
+        if bw <= 0 or rhi <= rlo:
             continue
         bx0 = box[p, 0]
-        by0 = box[p, 1]
         o = off[p] if keep else 0
-        _path_deposits(verts, path_vstart[p], path_vstart[p + 1], bx0, by0, bw, bh, acc, o)
+        _path_deposits(
+            verts, path_vstart[p], path_vstart[p + 1], bx0, by0, bw, bh, acc, o, rlo, rhi
+        )
         a = colors[p, 3]
         cr = colors[p, 0]
         cg = colors[p, 1]
         cb = colors[p, 2]
         flat = kinds[p] == FLAT
         stride = bw + 1
-        for r in range(bh):
+        for r in range(rlo, rhi):
             y = by0 + r
             base = o + r * stride
             wind = 0.0
@@ -570,7 +611,8 @@ def _path_edges_backward(
     verts: np.ndarray, path_vstart: np.ndarray, p: int, bx0: int, by0: int, bw: int, bh: int,
     acc: np.ndarray, dcov: np.ndarray, o: int, gverts: np.ndarray,
 ) -> None:  # fmt: skip
-    """Add to ``gverts`` what the edges of path ``p`` get from dL/dcov of its box (``dcov``)."""
+    """Add to ``gverts`` what the edges of path ``p`` get from dL/dcov of its box (``dcov``, laid
+    out like ``acc``)."""
     stride = bw + 1
     v0 = path_vstart[p]
     n = path_vstart[p + 1] - v0
@@ -587,7 +629,7 @@ def _path_edges_backward(
             acc,
             dcov,
             o,
-            0,
+            o,
             stride,
         )
         gverts[i, 0] += gxa
@@ -598,15 +640,16 @@ def _path_edges_backward(
 
 @njit(cache=True, nogil=True)
 def _path_pixels_backward(
-    grad_out: np.ndarray, p: int, bx0: int, by0: int, bw: int, bh: int, o: int,
+    grad_out: np.ndarray, p: int, bx0: int, by0: int, bw: int, rlo: int, rhi: int, o: int,
     colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
     kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
-    rgb: np.ndarray, grgb: np.ndarray, gsum: np.ndarray,
-) -> tuple[float, float, float, float]:  # fmt: skip
-    """The box pixels of path ``p``: dL/dcov into ``dcov``, ``grad_out`` passed under the path.
-
-    Returns dL/d its RGBA; a gradient path's RGB gradient goes to its paint parameters instead
-    (added to ``gsum``, row by row; ``rgb`` and ``grgb`` are scratch rows of the canvas width).
+    rgb: np.ndarray, grgb: np.ndarray, colour_rows: np.ndarray, ro: int,
+    paint_rows: np.ndarray, go: int,
+) -> None:  # fmt: skip
+    """Box rows ``rlo`` to ``rhi`` of path ``p``: dL/dcov into ``dcov`` (laid out like ``acc``),
+    ``grad_out`` passed under the path, and dL/d its RGBA summed per row into ``colour_rows[ro
+    + r]``; a gradient path's RGB gradient goes per row to its paint parameters,
+    ``paint_rows[go + r]``, instead (``rgb`` and ``grgb`` are scratch rows of the canvas width).
     """
     a = colors[p, 3]
     cr = colors[p, 0]
@@ -614,12 +657,12 @@ def _path_pixels_backward(
     cb = colors[p, 2]
     flat = kinds[p] == FLAT
     stride = bw + 1
-    sr = 0.0
-    sg = 0.0
-    sb = 0.0
-    sa = 0.0
-    for r in range(bh):
+    for r in range(rlo, rhi):
         y = by0 + r
+        sr = 0.0
+        sg = 0.0
+        sb = 0.0
+        sa = 0.0
         if not flat:
             paint_row(kinds, stops, params, p, y, bx0, bw, rgb)
         for c in range(bw):
@@ -633,7 +676,7 @@ def _path_pixels_backward(
                 cg = rgb[c, 1]
                 cb = rgb[c, 2]
             dot = g0 * (cr - under[k, 0]) + g1 * (cg - under[k, 1]) + g2 * (cb - under[k, 2])
-            dcov[r * stride + c] = a * dot
+            dcov[k] = a * dot
             cov = min(1.0, abs(acc[k]))
             if cov > 0.0:
                 ac = a * cov
@@ -654,46 +697,114 @@ def _path_pixels_backward(
                 grgb[c, 0] = 0.0
                 grgb[c, 1] = 0.0
                 grgb[c, 2] = 0.0
+        colour_rows[ro + r, 0] = sr
+        colour_rows[ro + r, 1] = sg
+        colour_rows[ro + r, 2] = sb
+        colour_rows[ro + r, 3] = sa
         if not flat:
+            gsum = paint_rows[go + r]
+            gsum[:] = 0.0
             paint_row_backward(kinds, stops, params, p, y, bx0, bw, grgb, gsum)
-    return sr, sg, sb, sa
 
 
 @njit(cache=True, nogil=True)
-def render_backward(
-    grad_out: np.ndarray, verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray,
-    off: np.ndarray, colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
-    kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
-    """Gradients of ``render_forward``: (dL/d vertex (V, 2), dL/d colour (P, 4), dL/d gradient
-    paint parameters (P, PARAMS); a gradient path's RGB gradient goes to the last).
-
-    Paths are visited in reverse paint order. For each: dL/dcov of its box pixels goes to the
-    scratch ``dcov`` (size of the largest box), colour gradients are summed, the running canvas
-    gradient ``grad_out`` (H, W, 3, float64, overwritten) is passed under the path, then the edges
-    of the path turn dL/dcov into vertex gradients.
-    """
+def row_offsets(box: np.ndarray, kinds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where each path's box rows start in the per-row colour sums, and in the per-row paint
+    sums of the gradient paths (each ``P + 1`` long, the last entry the total)."""
     n_paths = box.shape[0]
-    gverts = np.zeros(verts.shape, np.float64)
-    gcol = np.zeros((n_paths, 4), np.float64)
-    gparams = np.zeros(params.shape, np.float64)
+    colour_off = np.zeros(n_paths + 1, np.int64)
+    paint_off = np.zeros(n_paths + 1, np.int64)
+    for p in range(n_paths):
+        rows = box[p, 3] if box[p, 2] > 0 and box[p, 3] > 0 else 0
+        colour_off[p + 1] = colour_off[p] + rows
+        paint_off[p + 1] = paint_off[p] + (0 if kinds[p] == FLAT else rows)
+    return colour_off, paint_off
+
+
+@njit(cache=True, nogil=True)
+def render_backward_pixels(
+    grad_out: np.ndarray, box: np.ndarray, off: np.ndarray, colors: np.ndarray,
+    acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
+    kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
+    colour_rows: np.ndarray, colour_off: np.ndarray, paint_rows: np.ndarray,
+    paint_off: np.ndarray, row0: int, row1: int,
+) -> None:  # fmt: skip
+    """The pixel part of ``render_forward``'s gradient on canvas rows ``row0`` to ``row1``:
+    paths in reverse paint order, each getting dL/dcov of its box pixels (``dcov``, laid out
+    like ``acc``) and its per-row colour sums (`row_offsets`), while the canvas gradient
+    ``grad_out`` (H, W, 3, float64, overwritten) is passed under it. Bands run on threads."""
     rgb = np.empty((grad_out.shape[1], 3), np.float64)
     grgb = np.empty((grad_out.shape[1], 3), np.float64)
-    gsum = np.zeros(PARAMS, np.float64)
-    for p in range(n_paths - 1, -1, -1):
+    for p in range(box.shape[0] - 1, -1, -1):
+        bw = box[p, 2]
+        by0 = box[p, 1]
+        rlo = max(0, row0 - by0)
+        rhi = min(box[p, 3], row1 - by0)
+        if bw <= 0 or rhi <= rlo:
+            continue
+        _path_pixels_backward(
+            grad_out, p, box[p, 0], by0, bw, rlo, rhi, off[p], colors, acc, under, dcov,
+            kinds, stops, params, rgb, grgb, colour_rows, colour_off[p], paint_rows, paint_off[p],
+        )  # fmt: skip
+
+
+@njit(cache=True, nogil=True)
+def path_bands(box: np.ndarray, path_vstart: np.ndarray, parts: int) -> np.ndarray:
+    """``parts + 1`` path boundaries that split the edge pass into runs of about equal work."""
+    n_paths = box.shape[0]
+    work = np.empty(n_paths, np.float64)
+    total = 0.0
+    for p in range(n_paths):
+        work[p] = path_vstart[p + 1] - path_vstart[p] + box[p, 2] + box[p, 3] + 1.0
+        total += work[p]
+    bands = np.empty(parts + 1, np.int64)
+    bands[0] = 0
+    bands[parts] = n_paths
+    done = 0.0
+    p = 0
+    for i in range(1, parts):
+        goal = total * i / parts
+        while p < n_paths and done + work[p] <= goal:
+            done += work[p]
+            p += 1
+        bands[i] = max(p, bands[i - 1])
+    return bands
+
+
+@njit(cache=True, nogil=True)
+def render_backward_edges(
+    verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray, off: np.ndarray,
+    acc: np.ndarray, dcov: np.ndarray, gverts: np.ndarray, p0: int, p1: int,
+) -> None:  # fmt: skip
+    """The edge part of the gradient for paths ``p0`` to ``p1`` (exclusive): dL/dcov turned into
+    dL/d their vertices, added to ``gverts`` (V, 2). Paths own disjoint vertex rows, so runs of
+    paths can go to threads."""
+    for p in range(p1 - 1, p0 - 1, -1):
         bw = box[p, 2]
         bh = box[p, 3]
         if bw <= 0 or bh <= 0:
             continue
-        bx0 = box[p, 0]
-        by0 = box[p, 1]
-        o = off[p]
-        gsum[:] = 0.0
-        gcol[p, 0], gcol[p, 1], gcol[p, 2], gcol[p, 3] = _path_pixels_backward(
-            grad_out, p, bx0, by0, bw, bh, o, colors, acc, under, dcov,
-            kinds, stops, params, rgb, grgb, gsum,
-        )  # fmt: skip
+        _path_edges_backward(
+            verts, path_vstart, p, box[p, 0], box[p, 1], bw, bh, acc, dcov, off[p], gverts
+        )
+
+
+@njit(cache=True, nogil=True)
+def sum_rows(
+    colour_rows: np.ndarray, colour_off: np.ndarray, paint_rows: np.ndarray,
+    paint_off: np.ndarray, kinds: np.ndarray, params: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """dL/d colour (P, 4) and dL/d gradient paint parameters (P, PARAMS) from the per-row sums,
+    added row by row in order (the same result for any banding)."""
+    n_paths = colour_off.shape[0] - 1
+    gcol = np.zeros((n_paths, 4), np.float64)
+    gparams = np.zeros(params.shape, np.float64)
+    for p in range(n_paths):
+        for i in range(colour_off[p], colour_off[p + 1]):
+            for j in range(4):
+                gcol[p, j] += colour_rows[i, j]
         if kinds[p] != FLAT:
-            gparams[p, :] = gsum
-        _path_edges_backward(verts, path_vstart, p, bx0, by0, bw, bh, acc, dcov, o, gverts)
-    return gverts, gcol, gparams
+            for i in range(paint_off[p], paint_off[p + 1]):
+                for j in range(PARAMS):
+                    gparams[p, j] += paint_rows[i, j]
+    return gcol, gparams

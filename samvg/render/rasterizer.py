@@ -20,6 +20,7 @@ from samvg.errors import InputError
 from samvg.render import _kernels as K
 from samvg.render._paint_kernels import FLAT, LINEAR, MAX_STOPS, PARAMS, RADIAL
 from samvg.render.gradient_image import gradient_image
+from samvg.render.threads import render_threads, run_parts
 from samvg.scene import FlatPaint, LinearGradient, Paint, RadialGradient, Scene
 
 #: Maximum chord error (pixels) of the polyline that replaces each cubic segment.
@@ -270,21 +271,19 @@ class _Rasterize(torch.autograd.Function):
                 f"scene too large to rasterize: {n_cells} path-box pixels on a "
                 f"{width}x{height} canvas"
             ) from exc
-        K.render_forward(
-            verts,
-            vstart,
-            box,
-            off,
-            cols,
-            bg if bg.ndim == 1 else _NO_BACKGROUND,
-            canvas,
-            acc,
-            under,
-            keep,
-            kinds,
-            stops,
-            paint,
-        )
+        parts = min(render_threads(), height)
+        bands = K.row_bands(box, height, parts)
+        # With keep the bands fill disjoint rows of one buffer; without, each needs a scratch.
+        scratch = [acc] * parts if keep else [acc] + [np.empty_like(acc) for _ in range(parts - 1)]
+        fill = bg if bg.ndim == 1 else _NO_BACKGROUND
+
+        def forward_band(part: int) -> None:
+            K.render_forward(
+                verts, vstart, box, off, cols, fill, canvas, scratch[part],
+                under, keep, kinds, stops, paint, bands[part], bands[part + 1],
+            )  # fmt: skip
+
+        run_parts(forward_band, parts)
         ctx.col_dtype = colors.dtype
         ctx.paint_dtype = params.dtype
         ctx.image_dtype = image.dtype
@@ -292,7 +291,6 @@ class _Rasterize(torch.autograd.Function):
             ctx.state = (pts.shape[0], starts, seg_n, vstart, verts, box, off, acc, under, cols)
             ctx.paints = (kinds, stops, paint)
             ctx.clipped = clipped if clipped.any() else None
-            ctx.largest = largest
         return torch.from_numpy(canvas).to(dtype=flat_pts.dtype, device=flat_pts.device)
 
     @staticmethod
@@ -300,10 +298,7 @@ class _Rasterize(torch.autograd.Function):
     def backward(ctx: Any, grad_out: torch.Tensor) -> tuple[torch.Tensor | None, ...]:
         n_ctrl, starts, seg_n, vstart, verts, box, off, acc, under, cols = ctx.state
         go = np.array(grad_out.detach().cpu().numpy(), dtype=np.float64, order="C", copy=True)
-        dcov = np.empty(ctx.largest, np.float64)
-        gverts, gcol, gpaint = K.render_backward(
-            go, verts, vstart, box, off, cols, acc, under, dcov, *ctx.paints
-        )
+        gverts, gcol, gpaint = _backward(go, verts, vstart, box, off, cols, acc, under, ctx.paints)
         g_pts = g_col = g_paint = g_image = None
         if ctx.needs_input_grad[0]:
             g = K.flatten_backward(gverts, starts, seg_n, vstart, n_ctrl)
@@ -319,6 +314,49 @@ class _Rasterize(torch.autograd.Function):
             # order: what is left is the gradient with respect to the canvas before any path.
             g_image = torch.from_numpy(go).to(dtype=ctx.image_dtype, device=grad_out.device)
         return g_pts, g_col, g_paint, g_image, *([None] * 8)
+
+
+def _backward(
+    grad_out: np.ndarray,
+    verts: np.ndarray,
+    vstart: np.ndarray,
+    box: np.ndarray,
+    off: np.ndarray,
+    cols: np.ndarray,
+    acc: np.ndarray,
+    under: np.ndarray,
+    paints: tuple[np.ndarray, np.ndarray, np.ndarray],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """dL/d vertices, colours and gradient paint parameters from dL/d image ``grad_out``
+    (overwritten with dL/d the canvas under every path), on the rasterizer's threads: the
+    pixel part in row bands, then the edge part in runs of paths."""
+    kinds, stops, paint = paints
+    height = grad_out.shape[0]
+    parts = min(render_threads(), height)
+    colour_off, paint_off = K.row_offsets(box, kinds)
+    colour_rows = np.empty((int(colour_off[-1]), 4), np.float64)
+    paint_rows = np.empty((int(paint_off[-1]), PARAMS), np.float64)
+    dcov = np.empty(acc.shape[0], np.float64)
+    rows = K.row_bands(box, height, parts)
+
+    def pixel_band(part: int) -> None:
+        K.render_backward_pixels(
+            grad_out, box, off, cols, acc, under, dcov, kinds, stops, paint,
+            colour_rows, colour_off, paint_rows, paint_off, rows[part], rows[part + 1],
+        )  # fmt: skip
+
+    run_parts(pixel_band, parts)
+    gverts = np.zeros(verts.shape, np.float64)
+    paths = K.path_bands(box, vstart, parts)
+
+    def edge_run(part: int) -> None:
+        K.render_backward_edges(
+            verts, vstart, box, off, acc, dcov, gverts, paths[part], paths[part + 1]
+        )
+
+    run_parts(edge_run, parts)
+    gcol, gparams = K.sum_rows(colour_rows, colour_off, paint_rows, paint_off, kinds, paint)
+    return gverts, gcol, gparams
 
 
 def rasterize(
