@@ -5,9 +5,11 @@ translucent colours) at 256x256 and 512x512. For each: forward ms (no grad), for
 (MSE loss against a random target image, gradients w.r.t. points and colours) and resvg-py's time
 to render the same SVG text (what ``VectorImage.to_svg`` writes) to PNG; medians of repeats. The
 same scenes with every fill a gradient (linear and radial alternately, 3 stops; gradients also
-w.r.t. their parameters) give the gradient columns.
+w.r.t. their parameters) give the gradient columns. The rasterizer's own times are measured on
+one thread and on ``--render-threads`` (default: every core).
 
-Usage: python benchmarks/bench_render.py [--repeats N] [--torch-threads T] [--out FILE]
+Usage: python benchmarks/bench_render.py [--repeats N] [--torch-threads T] [--render-threads R]
+[--out FILE]
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ import torch
 from samvg.render import rasterize, warmup
 from samvg.render._paint_kernels import LINEAR, PARAMS, RADIAL
 from samvg.render.rasterizer import GradientPaints
+from samvg.render.threads import default_threads, using_render_threads
 from samvg.vector_image import VectorImage, VectorPath
 
 SIZES = (256, 512)
@@ -70,7 +73,7 @@ def median_ms(function, repeats: int) -> float:
     return 1000 * statistics.median(times)
 
 
-def run(repeats: int) -> list[dict[str, float]]:
+def run(repeats: int, threads: int) -> list[dict[str, float]]:
     rng = np.random.default_rng(0)
     rows = []
     for size in SIZES:
@@ -111,36 +114,44 @@ def run(repeats: int) -> list[dict[str, float]]:
                 image = rasterize(pts, cols, size, size, gradients=paints)
                 ((image - target) ** 2).mean().backward()
 
-            row = {
-                "size": size,
-                "paths": n_paths,
-                "forward": median_ms(forward, repeats),
-                "forward_backward": median_ms(forward_backward, repeats),
-                "resvg": median_ms(resvg, repeats),
-                "gradient_forward": median_ms(gradient_forward, repeats),
-                "gradient_forward_backward": median_ms(gradient_forward_backward, repeats),
-            }
+            with using_render_threads(1):
+                row = {
+                    "size": size,
+                    "paths": n_paths,
+                    "forward": median_ms(forward, repeats),
+                    "forward_backward": median_ms(forward_backward, repeats),
+                    "resvg": median_ms(resvg, repeats),
+                    "gradient_forward": median_ms(gradient_forward, repeats),
+                    "gradient_forward_backward": median_ms(gradient_forward_backward, repeats),
+                }
+            with using_render_threads(threads):
+                row["threaded_forward"] = median_ms(forward, repeats)
+                row["threaded_forward_backward"] = median_ms(forward_backward, repeats)
             row["ratio"] = row["forward_backward"] / row["resvg"]
             rows.append(row)
             print(
                 f"{size}x{size} P={n_paths}: fwd {row['forward']:.2f} ms, "
-                f"fwd+bwd {row['forward_backward']:.2f} ms, resvg {row['resvg']:.2f} ms",
+                f"fwd+bwd {row['forward_backward']:.2f} ms, resvg {row['resvg']:.2f} ms; "
+                f"{threads} threads: fwd {row['threaded_forward']:.2f} ms, "
+                f"fwd+bwd {row['threaded_forward_backward']:.2f} ms",
                 flush=True,
             )
     return rows
 
 
-def table(rows: list[dict[str, float]]) -> str:
+def table(rows: list[dict[str, float]], threads: int) -> str:
     lines = [
         "| canvas | paths (K=4) | forward ms | forward+backward ms | resvg-py ms "
-        "| fwd+bwd / resvg | gradient fills: forward ms | gradient fills: fwd+bwd ms |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|",
+        "| fwd+bwd / resvg | gradient fills: forward ms | gradient fills: fwd+bwd ms "
+        f"| {threads} threads: forward ms | {threads} threads: fwd+bwd ms |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         lines.append(
             f"| {r['size']}x{r['size']} | {r['paths']} | {r['forward']:.2f} | "
             f"{r['forward_backward']:.2f} | {r['resvg']:.2f} | {r['ratio']:.2f} | "
-            f"{r['gradient_forward']:.2f} | {r['gradient_forward_backward']:.2f} |"
+            f"{r['gradient_forward']:.2f} | {r['gradient_forward_backward']:.2f} | "
+            f"{r['threaded_forward']:.2f} | {r['threaded_forward_backward']:.2f} |"
         )
     return "\n".join(lines)
 
@@ -157,6 +168,12 @@ def main() -> None:
         "machine torch's thread pool adds large, erratic wake-up delays to tiny tensor ops.",
     )
     parser.add_argument(
+        "--render-threads",
+        type=int,
+        default=default_threads(),
+        help="the rasterizer's threads for the threaded columns (default: every core)",
+    )
+    parser.add_argument(
         "--out", type=Path, default=Path(__file__).resolve().parent / "results" / "render.md"
     )
     args = parser.parse_args()
@@ -166,8 +183,8 @@ def main() -> None:
     start = time.perf_counter()
     warmup()
     warm = time.perf_counter() - start
-    rows = run(args.repeats)
-    body = table(rows)
+    rows = run(args.repeats, args.render_threads)
+    body = table(rows, args.render_threads)
     machine = (
         f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
         f"torch {torch.__version__} (intra-op threads: {torch.get_num_threads()}), "
@@ -180,7 +197,8 @@ def main() -> None:
         "Scenes: P random star-shaped paths (K = 4 cubics, radius 5-60 px, translucent). "
         "forward+backward = rasterize, MSE against a random target, backward to points and "
         "colours. resvg-py renders the same SVG text (2 decimals) to PNG over white.\n"
-        "The rasterizer kernels are single-threaded, as is resvg. torch threads "
+        "The first columns run the rasterizer on one thread, as resvg runs; the last two on "
+        f"{args.render_threads} (row bands and runs of paths, the same bits). torch threads "
         f"(`--torch-threads`, 0 = torch default): {args.torch_threads}; with torch's default "
         "pool on a 2-core machine where another process keeps one core busy, the MSE loss "
         "and its backward alone take ~40 ms instead of ~0.6 ms (thread wake-up stalls).\n"
