@@ -187,15 +187,15 @@ def main() -> None:
         "--records",
         type=Path,
         default=RECORDS,
-        help="budget records' folder (bench_speed.py's time-against-paths plot reads "
-        "benchmarks/results/speed/paths)",
+        help="budget records' folder, written by budget and read by report (bench_speed.py's "
+        "time-against-paths plot reads benchmarks/results/speed/paths)",
     )
     arguments = parser.parse_args()
     overrides = dict(_setting(text) for text in arguments.set)
     if arguments.study == "report":
         from detail_report import write_report
 
-        write_report(RECORDS, GEOMETRY)
+        write_report(RECORDS, GEOMETRY, arguments.records if arguments.records != RECORDS else None)
         return
     categories = arguments.categories.split(",") if arguments.categories else None
     if arguments.study == "rate" and categories is None:

@@ -4,6 +4,10 @@ older commit against the working tree, run alternately image by image on one mac
     python benchmarks/bench_speed.py run --old 45a9978 --per-category 4
     python benchmarks/bench_speed.py report --old 45a9978
 
+``--new REV`` measures a commit instead of the working tree (so the tree can change while it
+runs), and ``--records DIR`` keeps a run's records apart from an earlier one's (another
+machine's, say).
+
 ``run`` checks the old commit out in a temporary git worktree and, for each bench image and
 preset, runs the old code and then the new code in fresh subprocesses (so neither warms the
 other's caches), each on the machine as it is at that moment: the machine is noisy, so the
@@ -90,7 +94,12 @@ def measure(record: dict[str, Any], entry: dict[str, str], lpips: Any) -> dict[s
 
 
 def run_study(
-    old: str, per_category: int, presets: list[str], keep_svg: Path | None = None
+    old: str,
+    per_category: int,
+    presets: list[str],
+    keep_svg: Path | None = None,
+    new: str | None = None,
+    records: Path = RECORDS,
 ) -> None:
     sys.path.insert(0, str(REPO / "benchmarks"))
     from bench_images import BENCH, bench_entries
@@ -100,14 +109,21 @@ def run_study(
 
     lpips = load_lpips()
     with tempfile.TemporaryDirectory() as folder:
-        old_tree = Path(folder) / "old"
-        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(old_tree), old],
-                       check=True, capture_output=True)  # fmt: skip
+        trees = {old: Path(folder) / "old"}
+        if new is not None:
+            trees[new] = Path(folder) / "new"
+        for revision, tree in trees.items():
+            subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(tree),
+                            revision], check=True, capture_output=True)  # fmt: skip
+        new_tree = REPO if new is None else trees[new]
+        entries = bench_entries(per_category)
         try:
-            for entry in bench_entries(per_category):
+            for tree in {trees[old], new_tree}:  # compile (and cache) every numba kernel first
+                run_tree(tree, BENCH / entries[0]["png"], "fast")
+            for entry in entries:
                 for preset in presets:
-                    for label, tree in ((f"old-{old}", old_tree), ("new", REPO)):
-                        path = RECORDS / label / f"{entry['id']}.{preset}.json"
+                    for label, tree in ((f"old-{old}", trees[old]), ("new", new_tree)):
+                        path = records / label / f"{entry['id']}.{preset}.json"
                         if path.exists():
                             continue
                         image = BENCH / entry["png"]
@@ -122,13 +138,14 @@ def run_study(
                         atomic_write_text(path, json.dumps(record, indent=1))
                         print(label, entry["id"], preset, f"{record['seconds']:.1f}s", flush=True)
         finally:
-            subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force",
-                            str(old_tree)], check=False)  # fmt: skip
+            for tree in trees.values():
+                subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force",
+                                str(tree)], check=False)  # fmt: skip
 
 
-def _records(label: str) -> dict[tuple[str, str], dict[str, Any]]:
+def _records(label: str, records: Path = RECORDS) -> dict[tuple[str, str], dict[str, Any]]:
     found = {}
-    for path in sorted((RECORDS / label).glob("*.json")):
+    for path in sorted((records / label).glob("*.json")):
         record = json.loads(path.read_text())
         found[(record["id"], record["preset"])] = record
     return found
@@ -166,17 +183,25 @@ def _quality_rows(old: dict, new: dict, keys: list, preset: str) -> list[str]:
     return rows
 
 
-def write_report(old_label: str) -> None:
-    old, new = _records(f"old-{old_label}"), _records("new")
+def write_report(old_label: str, records: Path = RECORDS, new_label: str | None = None) -> None:
+    old, new = _records(f"old-{old_label}", records), _records("new", records)
     if not any(key in new for key in old):
-        raise SystemExit(f"no paired records under {RECORDS} for {old_label}: run `run` first")
+        raise SystemExit(f"no paired records under {records} for {old_label}: run `run` first")
+    shown = records.relative_to(REPO) if records.is_relative_to(REPO) else records
+    new_text = (
+        "the working tree when the records were made"
+        if new_label is None
+        else (f"commit `{new_label}`")
+    )
     lines = [
         "# Speed: per-stage time and quality, before and after (issue 14)",
         "",
-        f"Old: commit `{old_label}`; new: the working tree when the records were made. Both run "
-        "alternately, image by image, in fresh processes on the same machine (2 cores), by "
-        "`python benchmarks/bench_speed.py run --old " + old_label + "`. Seconds are medians "
-        "over the images; the ratio is the median of the per-image old/new ratios.",
+        f"Old: commit `{old_label}`; new: {new_text}. Both run alternately, image by image, in "
+        "fresh processes on the same machine (2 cores), by `python benchmarks/bench_speed.py run "
+        f"--old {old_label}"
+        + ("" if new_label is None else f" --new {new_label}")
+        + f" --records {shown}`. Seconds are medians over the images; the ratio is the median "
+        "of the per-image old/new ratios.",
         "",
         "| preset | stage | old s | new s | speed-up |",
         "|---|---|---|---|---|",
@@ -257,11 +282,17 @@ def main() -> None:
     parser.add_argument("--per-category", type=int, default=4)
     parser.add_argument("--presets", default="default,fast")
     parser.add_argument("--keep-svg", type=Path, help="also write every run's SVG to this folder")
+    parser.add_argument("--new", help="the commit to measure (default: the working tree)")
+    parser.add_argument("--records", type=Path, default=RECORDS, help="the records' folder")
     arguments = parser.parse_args()
+    records = arguments.records.resolve()
     if arguments.study == "run":
         presets = arguments.presets.split(",")
-        run_study(arguments.old, arguments.per_category, presets, arguments.keep_svg)
-    write_report(arguments.old)
+        run_study(
+            arguments.old, arguments.per_category, presets, arguments.keep_svg, arguments.new,
+            records,
+        )  # fmt: skip
+    write_report(arguments.old, records, arguments.new)
 
 
 if __name__ == "__main__":

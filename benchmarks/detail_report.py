@@ -77,28 +77,31 @@ def default_table(geometry: Path) -> list[str]:
     return lines
 
 
-def budget_tables(records: list[dict[str, Any]]) -> list[str]:
+def budget_tables(records: list[dict[str, Any]], folder: Path) -> list[str]:
     """Per budget and category: each method's means, and samvg's wins against each baseline
-    (lower MSE and lower LPIPS on the same image)."""
+    (lower MSE and lower LPIPS on the same image). samvg is its default (gradient fills) where
+    those records exist, else flat fills."""
     rows = [r for r in records if r.get("study") == "budget"]
+    subject = "samvg-gradients" if any(r["method"] == "samvg-gradients" for r in rows) else "samvg"
     by_key: dict[tuple[int, str], dict[str, dict[str, Any]]] = defaultdict(dict)
     for row in rows:
         by_key[(row["budget"], row["id"])][row["method"]] = row
     lines = [
         "## Equal budgets",
         "",
-        "`python benchmarks/bench_detail.py budget --per-category 4 --paths 16,64`: samvg with "
-        "`--paths N`; VTracer with its settings searched for the path count closest to N "
-        "(`samvg.baselines.vtracer_trace`); the LIVE-style baseline and random init (diffvg) "
-        f"fitted with samvg's losses for {2 * 500} steps. Means over the images with every "
-        "method; *wins* = images where samvg has lower MSE **and** lower LPIPS than that "
-        "method (the goal: ≥ 90 % in every category).",
+        "`python benchmarks/bench_detail.py budget --per-category 4 --paths 16,64,256 --methods "
+        f"samvg-gradients,vtracer,live,diffvg --records {_shown(folder)}`: samvg "
+        f"(`{subject}`: "
+        + ("the default, gradient fills" if subject != "samvg" else "flat fills")
+        + ") with `--paths N`; VTracer with its settings searched for the path count closest to "
+        "N (`samvg.baselines.vtracer_trace`); the LIVE-style baseline and random init (diffvg) "
+        f"fitted with samvg's losses for {2 * 500} steps. Means over the images that have every "
+        "method's record; *wins* = images where samvg has lower MSE **and** lower LPIPS than "
+        "that method (the goal: ≥ 90 % in every category).",
     ]
     for budget in sorted({b for b, _ in by_key}):
-        complete = {i: m for (b, i), m in by_key.items() if b == budget and "samvg" in m}
-        methods = sorted(
-            {name for m in complete.values() for name in m} - {"samvg", "samvg-gradients"}
-        )
+        complete = {i: m for (b, i), m in by_key.items() if b == budget and subject in m}
+        methods = sorted({name for m in complete.values() for name in m} - {"samvg", subject})
         lines += [
             "",
             f"### N = {budget}",
@@ -108,27 +111,40 @@ def budget_tables(records: list[dict[str, Any]]) -> list[str]:
         ]
         by_category: dict[str, list[dict[str, dict[str, Any]]]] = defaultdict(list)
         for found in complete.values():
-            by_category[found["samvg"]["category"]].append(found)
-        for category in CATEGORIES:
-            images = [m for m in by_category.get(category, []) if set(methods) <= set(m)]
-            for method in ["samvg", *methods]:
-                if not images:
-                    continue
-                group = [m[method] for m in images]
-                wins = ""
-                if method != "samvg":
-                    won = sum(
-                        m["samvg"]["mse"] < m[method]["mse"]
-                        and m["samvg"]["lpips"] < m[method]["lpips"]
-                        for m in images
-                    )
-                    wins = f"{won}/{len(images)}"
-                lines.append(
-                    f"| {category} | {len(images)} | {method} | {_mean(group, 'paths'):.1f} | "
-                    f"{1e3 * _mean(group, 'mse'):.2f} | {_mean(group, 'lpips'):.3f} | "
-                    f"{_mean(group, 'svg_bytes'):.0f} | {_mean(group, 'seconds'):.1f} | {wins} |"
-                )
+            by_category[found[subject]["category"]].append(found)
+            by_category["all"].append(found)
+        for category in (*CATEGORIES, "all"):
+            for method in [subject, *methods]:
+                lines += _budget_row(category, by_category.get(category, []), subject, method)
     return lines
+
+
+def _shown(folder: Path) -> str:
+    """``folder`` relative to the repository where it lies inside it."""
+    return str(folder.relative_to(REPO)) if folder.is_relative_to(REPO) else str(folder)
+
+
+def _budget_row(
+    category: str, found: list[dict[str, dict[str, Any]]], subject: str, method: str
+) -> list[str]:
+    """One table row: ``method``'s means over the images of ``found`` that have its record,
+    and samvg's wins against it there."""
+    images = [m for m in found if method in m]
+    if not images:
+        return []
+    group = [m[method] for m in images]
+    wins = ""
+    if method != subject:
+        won = sum(
+            m[subject]["mse"] < m[method]["mse"] and m[subject]["lpips"] < m[method]["lpips"]
+            for m in images
+        )
+        wins = f"{won}/{len(images)} ({won / len(images):.0%})"
+    return [
+        f"| {category} | {len(images)} | {method} | {_mean(group, 'paths'):.1f} | "
+        f"{1e3 * _mean(group, 'mse'):.2f} | {_mean(group, 'lpips'):.3f} | "
+        f"{_mean(group, 'svg_bytes'):.0f} | {_mean(group, 'seconds'):.1f} | {wins} |"
+    ]
 
 
 def gradient_table(records: list[dict[str, Any]]) -> list[str]:
@@ -241,8 +257,13 @@ def rate_plot(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
-def write_report(records_folder: Path, geometry: Path) -> None:
+def write_report(records_folder: Path, geometry: Path, budget_folder: Path | None = None) -> None:
+    """detail.md from the records: the default against VTracer (``geometry``), the equal-budget
+    tables (``budget_folder``, else the budget records of ``records_folder``), the gradient
+    table and the rate-distortion plot (``records_folder``)."""
     records = _records(records_folder, "*.json")
+    budget_folder = budget_folder or records_folder
+    budget_records = _records(budget_folder, "*.json")
     lines = [
         "# Detail at any path budget (issue 11)",
         "",
@@ -251,7 +272,7 @@ def write_report(records_folder: Path, geometry: Path) -> None:
         "",
         *default_table(geometry),
         "",
-        *budget_tables(records),
+        *budget_tables(budget_records, budget_folder),
         *gradient_table(records),
         *rate_plot(records),
     ]

@@ -301,10 +301,12 @@ class Config:
     seed: int = 0
     device: str = "cpu"
     threads: int | None = None
-    """Threads for SAM (torch's) and for the rasterizer's kernels (None: torch's default, and
-    every core for the rasterizer). Fitting's torch work (LPIPS, losses) runs on one thread: its
-    tensors are small, and torch's pool stalls whenever another process holds a core. The
-    result does not depend on the rasterizer's thread count."""
+    """Threads for SAM (torch's) and for the rasterizer's kernels (None: torch's setting, and
+    the rasterizer's, by default every core). Fitting's torch work (LPIPS, losses) runs on one
+    thread: its tensors are small, and torch's pool stalls whenever another process holds a
+    core. The rasterizer draws the same image on any thread count; its colour gradients are
+    summed per thread, so a long fit can end a little differently on another count (the same
+    for a given count, every run)."""
 
     def __init__(
         self,

@@ -109,11 +109,13 @@ def _timed(result: PipelineResult, stage: str) -> Iterator[None]:
 
 @contextlib.contextmanager
 def _threads(threads: int | None) -> Iterator[None]:
-    """torch's threads (SAM) and the rasterizer's set to ``threads`` for the run (None: their
-    defaults), and set back after it."""
+    """torch's threads (SAM) and the rasterizer's set to ``threads`` for the run, and set back
+    after it (None: both left as they are)."""
+    if threads is None:
+        yield
+        return
     previous = torch.get_num_threads()
-    if threads is not None:
-        torch.set_num_threads(threads)
+    torch.set_num_threads(threads)
     try:
         with using_render_threads(threads):
             yield

@@ -30,7 +30,8 @@ def test_round_trip_keeps_geometry_colours_and_background():
 def test_precision_rounds_coordinates():
     image = VectorImage(10, 10, [VectorPath(np.array([[1.23456, 2.5], [3, 4], [5, 6.789]]))])
     text = image.to_svg(precision=2)
-    assert 'd="M1.23 2.5C3 4 5 6.79 1.23 2.5Z"' in text
+    # relative steps between the rounded points: (3, 4) - (1.23, 2.5) = (1.77, 1.5), ...
+    assert 'd="M1.23 2.5c1.77 1.5 3.77 4.29 0 0z"' in text
     assert 'width="10" height="10" viewBox="0 0 10 10"' in text
 
 

@@ -49,7 +49,7 @@ import math
 import numpy as np
 from numba import njit
 
-from samvg.render._paint_kernels import FLAT, PARAMS, paint_row, paint_row_backward
+from samvg.render._paint_kernels import FLAT, paint_row, paint_row_backward
 
 _MAX_PIECES = 256
 _EPS_ACC = 1e-9
@@ -643,13 +643,12 @@ def _path_pixels_backward(
     grad_out: np.ndarray, p: int, bx0: int, by0: int, bw: int, rlo: int, rhi: int, o: int,
     colors: np.ndarray, acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
     kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
-    rgb: np.ndarray, grgb: np.ndarray, colour_rows: np.ndarray, ro: int,
-    paint_rows: np.ndarray, go: int,
-) -> None:  # fmt: skip
-    """Box rows ``rlo`` to ``rhi`` of path ``p``: dL/dcov into ``dcov`` (laid out like ``acc``),
-    ``grad_out`` passed under the path, and dL/d its RGBA summed per row into ``colour_rows[ro
-    + r]``; a gradient path's RGB gradient goes per row to its paint parameters,
-    ``paint_rows[go + r]``, instead (``rgb`` and ``grgb`` are scratch rows of the canvas width).
+    rgb: np.ndarray, grgb: np.ndarray, gsum: np.ndarray,
+) -> tuple[float, float, float, float]:  # fmt: skip
+    """Box rows ``rlo`` to ``rhi`` of path ``p``: dL/dcov into ``dcov`` (laid out like ``acc``)
+    and ``grad_out`` passed under the path. Returns dL/d its RGBA from these rows; a gradient
+    path's RGB gradient goes to its paint parameters instead (added to ``gsum``, row by row;
+    ``rgb`` and ``grgb`` are scratch rows of the canvas width).
     """
     a = colors[p, 3]
     cr = colors[p, 0]
@@ -657,12 +656,12 @@ def _path_pixels_backward(
     cb = colors[p, 2]
     flat = kinds[p] == FLAT
     stride = bw + 1
+    sr = 0.0
+    sg = 0.0
+    sb = 0.0
+    sa = 0.0
     for r in range(rlo, rhi):
         y = by0 + r
-        sr = 0.0
-        sg = 0.0
-        sb = 0.0
-        sa = 0.0
         if not flat:
             paint_row(kinds, stops, params, p, y, bx0, bw, rgb)
         for c in range(bw):
@@ -697,28 +696,9 @@ def _path_pixels_backward(
                 grgb[c, 0] = 0.0
                 grgb[c, 1] = 0.0
                 grgb[c, 2] = 0.0
-        colour_rows[ro + r, 0] = sr
-        colour_rows[ro + r, 1] = sg
-        colour_rows[ro + r, 2] = sb
-        colour_rows[ro + r, 3] = sa
         if not flat:
-            gsum = paint_rows[go + r]
-            gsum[:] = 0.0
             paint_row_backward(kinds, stops, params, p, y, bx0, bw, grgb, gsum)
-
-
-@njit(cache=True, nogil=True)
-def row_offsets(box: np.ndarray, kinds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Where each path's box rows start in the per-row colour sums, and in the per-row paint
-    sums of the gradient paths (each ``P + 1`` long, the last entry the total)."""
-    n_paths = box.shape[0]
-    colour_off = np.zeros(n_paths + 1, np.int64)
-    paint_off = np.zeros(n_paths + 1, np.int64)
-    for p in range(n_paths):
-        rows = box[p, 3] if box[p, 2] > 0 and box[p, 3] > 0 else 0
-        colour_off[p + 1] = colour_off[p] + rows
-        paint_off[p + 1] = paint_off[p] + (0 if kinds[p] == FLAT else rows)
-    return colour_off, paint_off
+    return sr, sg, sb, sa
 
 
 @njit(cache=True, nogil=True)
@@ -726,13 +706,15 @@ def render_backward_pixels(
     grad_out: np.ndarray, box: np.ndarray, off: np.ndarray, colors: np.ndarray,
     acc: np.ndarray, under: np.ndarray, dcov: np.ndarray,
     kinds: np.ndarray, stops: np.ndarray, params: np.ndarray,
-    colour_rows: np.ndarray, colour_off: np.ndarray, paint_rows: np.ndarray,
-    paint_off: np.ndarray, row0: int, row1: int,
+    gcol: np.ndarray, gparams: np.ndarray, row0: int, row1: int,
 ) -> None:  # fmt: skip
     """The pixel part of ``render_forward``'s gradient on canvas rows ``row0`` to ``row1``:
     paths in reverse paint order, each getting dL/dcov of its box pixels (``dcov``, laid out
-    like ``acc``) and its per-row colour sums (`row_offsets`), while the canvas gradient
-    ``grad_out`` (H, W, 3, float64, overwritten) is passed under it. Bands run on threads."""
+    like ``acc``) and its colour gradient from these rows (``gcol`` (P, 4), and ``gparams``
+    (P, PARAMS) for gradient paints, both zeroed by the caller), while the canvas gradient
+    ``grad_out`` (H, W, 3, float64, overwritten) is passed under it. Each band of rows has its
+    own ``gcol`` and ``gparams`` (bands run on threads); one band over the whole canvas sums
+    every path's pixels in row-major order."""
     rgb = np.empty((grad_out.shape[1], 3), np.float64)
     grgb = np.empty((grad_out.shape[1], 3), np.float64)
     for p in range(box.shape[0] - 1, -1, -1):
@@ -742,9 +724,9 @@ def render_backward_pixels(
         rhi = min(box[p, 3], row1 - by0)
         if bw <= 0 or rhi <= rlo:
             continue
-        _path_pixels_backward(
+        gcol[p, 0], gcol[p, 1], gcol[p, 2], gcol[p, 3] = _path_pixels_backward(
             grad_out, p, box[p, 0], by0, bw, rlo, rhi, off[p], colors, acc, under, dcov,
-            kinds, stops, params, rgb, grgb, colour_rows, colour_off[p], paint_rows, paint_off[p],
+            kinds, stops, params, rgb, grgb, gparams[p],
         )  # fmt: skip
 
 
@@ -787,24 +769,3 @@ def render_backward_edges(
         _path_edges_backward(
             verts, path_vstart, p, box[p, 0], box[p, 1], bw, bh, acc, dcov, off[p], gverts
         )
-
-
-@njit(cache=True, nogil=True)
-def sum_rows(
-    colour_rows: np.ndarray, colour_off: np.ndarray, paint_rows: np.ndarray,
-    paint_off: np.ndarray, kinds: np.ndarray, params: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """dL/d colour (P, 4) and dL/d gradient paint parameters (P, PARAMS) from the per-row sums,
-    added row by row in order (the same result for any banding)."""
-    n_paths = colour_off.shape[0] - 1
-    gcol = np.zeros((n_paths, 4), np.float64)
-    gparams = np.zeros(params.shape, np.float64)
-    for p in range(n_paths):
-        for i in range(colour_off[p], colour_off[p + 1]):
-            for j in range(4):
-                gcol[p, j] += colour_rows[i, j]
-        if kinds[p] != FLAT:
-            for i in range(paint_off[p], paint_off[p + 1]):
-                for j in range(PARAMS):
-                    gparams[p, j] += paint_rows[i, j]
-    return gcol, gparams

@@ -329,20 +329,21 @@ def _backward(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """dL/d vertices, colours and gradient paint parameters from dL/d image ``grad_out``
     (overwritten with dL/d the canvas under every path), on the rasterizer's threads: the
-    pixel part in row bands, then the edge part in runs of paths."""
+    pixel part in row bands, then the edge part in runs of paths. The image and the vertex
+    gradients are the same on any thread count; colour gradients are summed per band, then
+    over the bands (one band sums in the order of a single-threaded pass)."""
     kinds, stops, paint = paints
     height = grad_out.shape[0]
     parts = min(render_threads(), height)
-    colour_off, paint_off = K.row_offsets(box, kinds)
-    colour_rows = np.empty((int(colour_off[-1]), 4), np.float64)
-    paint_rows = np.empty((int(paint_off[-1]), PARAMS), np.float64)
+    colour_sums = np.zeros((parts, box.shape[0], 4), np.float64)
+    paint_sums = np.zeros((parts, *paint.shape), np.float64)
     dcov = np.empty(acc.shape[0], np.float64)
     rows = K.row_bands(box, height, parts)
 
     def pixel_band(part: int) -> None:
         K.render_backward_pixels(
             grad_out, box, off, cols, acc, under, dcov, kinds, stops, paint,
-            colour_rows, colour_off, paint_rows, paint_off, rows[part], rows[part + 1],
+            colour_sums[part], paint_sums[part], rows[part], rows[part + 1],
         )  # fmt: skip
 
     run_parts(pixel_band, parts)
@@ -355,8 +356,7 @@ def _backward(
         )
 
     run_parts(edge_run, parts)
-    gcol, gparams = K.sum_rows(colour_rows, colour_off, paint_rows, paint_off, kinds, paint)
-    return gverts, gcol, gparams
+    return gverts, colour_sums.sum(axis=0), paint_sums.sum(axis=0)
 
 
 def rasterize(

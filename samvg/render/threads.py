@@ -2,8 +2,10 @@
 
 The numba kernels release the GIL, so plain Python threads run them side by side: one band of
 canvas rows per thread for the forward pass and the pixel part of the backward pass, one run of
-paths per thread for the edge part. Every pixel, and every path's gradient, is computed by the
-same arithmetic whichever thread does it, so the result does not depend on the thread count.
+paths per thread for the edge part. Every pixel and every vertex gradient is computed by the
+same arithmetic whichever thread does it; colour gradients are summed per band and then over
+the bands, so they match a single thread's to the last bits only (and exactly on one thread).
+A given thread count gives the same bits on every run.
 (numba's own parallel layers were not used: their worker pools spin and fight torch's.)
 """
 

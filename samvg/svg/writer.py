@@ -1,8 +1,11 @@
 """SVG text of a `Scene`: width, height and viewBox, an optional background rectangle, and one
-``<path>`` of absolute cubic commands per path, coordinates rounded to a fixed precision. A
-gradient fill is a ``<linearGradient>`` or ``<radialGradient>`` (userSpaceOnUse) in ``<defs>``,
-one id per path (``g<path number>``), referenced by ``fill="url(#…)"``; a background gradient
-is the background rectangle's fill, id ``bg``.
+``<path>`` per path: an absolute move, then relative cubic commands (``c``, repeated
+implicitly), coordinates rounded to a fixed precision first so the relative steps add up to
+exactly the rounded points, numbers written as short as SVG allows (no leading zero, no
+separator before a minus sign). A gradient fill is a ``<linearGradient>`` or
+``<radialGradient>`` (userSpaceOnUse) in ``<defs>``, ids ``g0``, ``g1``, … with paths of
+identical gradients sharing one, referenced by ``fill="url(#…)"``; a background gradient is the
+background rectangle's fill, id ``bg``.
 
 Written by hand: the output is a dozen lines of fixed shape, and its bytes must not depend on
 a library's formatting choices (tests compare them).
@@ -50,18 +53,38 @@ def hex_colour(rgb: Sequence[float]) -> str:
     return "#" + "".join(f"{round(min(max(c, 0.0), 1.0) * 255):02x}" for c in rgb)
 
 
+def _unit_text(units: int, precision: int) -> str:
+    """A value given in units of ``10 ** -precision``, shortest form (``-.5``, ``12``, ``3.25``)."""
+    whole, fraction = divmod(abs(int(units)), 10**precision)
+    sign = "-" if units < 0 else ""
+    if not fraction:
+        return f"{sign}{whole}"
+    digits = f"{fraction:0{precision}d}".rstrip("0")
+    return f"{sign}{whole or ''}.{digits}"
+
+
+def _joined(numbers: list[str]) -> str:
+    """Numbers of one command, separated by a space except before a minus sign."""
+    return "".join(
+        text if index == 0 or text[0] == "-" else f" {text}" for index, text in enumerate(numbers)
+    )
+
+
 def path_data(points: np.ndarray, precision: int) -> str:
-    """``M…C…Z`` for one closed path of 3K control points."""
-
-    def pair(p: np.ndarray) -> str:
-        return f"{number(p[0], precision)} {number(p[1], precision)}"
-
-    count = points.shape[0]
-    parts = [f"M{pair(points[0])}"]
+    """``M…c…z`` for one closed path of 3K control points: the start absolute, then each cubic
+    relative to the end of the one before (its offsets taken between rounded points)."""
+    units = np.rint(np.asarray(points, dtype=np.float64) * 10**precision).astype(np.int64)
+    count = units.shape[0]
+    start = units[0]
+    parts = [f"M{_joined([_unit_text(v, precision) for v in start])}c"]
+    current = start
+    numbers: list[str] = []
     for k in range(count // 3):
-        c1, c2, end = points[3 * k + 1], points[3 * k + 2], points[(3 * k + 3) % count]
-        parts.append(f"C{pair(c1)} {pair(c2)} {pair(end)}")
-    parts.append("Z")
+        segment = (units[3 * k + 1], units[3 * k + 2], units[(3 * k + 3) % count])
+        numbers += [_unit_text(v, precision) for point in segment for v in point - current]
+        current = segment[2]
+    parts.append(_joined(numbers))
+    parts.append("z")
     return "".join(parts)
 
 
@@ -79,20 +102,37 @@ def scene_to_svg(scene: Scene, precision: int = 2) -> str:
             definitions.append(gradient_element(scene.background_gradient, "bg", precision))
             fill = "url(#bg)"
         lines.append(f'<rect width="{scene.width}" height="{scene.height}" fill="{fill}"/>')
-    definitions += [
-        gradient_element(paint, f"g{index}", precision)
-        for index, paint in enumerate(scene.paints)
-        if not isinstance(paint, FlatPaint)
-    ]
+    gradient_ids, gradient_definitions = _shared_gradients(scene.paints, precision)
+    definitions += gradient_definitions
     if definitions:
         lines += ["<defs>", *definitions, "</defs>"]
     for index, (points, paint) in enumerate(scene.paths()):
         opacity = paint.rgba[3]
         opacity_attribute = "" if opacity >= 1.0 else f' fill-opacity="{number(opacity, 3)}"'
-        fill = hex_colour(paint.rgba[:3]) if isinstance(paint, FlatPaint) else f"url(#g{index})"
+        fill = (
+            f"url(#{gradient_ids[index]})" if index in gradient_ids else hex_colour(paint.rgba[:3])
+        )
         lines.append(f'<path d="{path_data(points, precision)}" fill="{fill}"{opacity_attribute}/>')
     lines.append("</svg>")
     return "\n".join(lines) + "\n"
+
+
+def _shared_gradients(paints: Sequence[Paint], precision: int) -> tuple[dict[int, str], list[str]]:
+    """The gradient id of every path with a gradient fill (``g0``, ``g1``, … in order of first
+    use, one per distinct element as written: a path split in two keeps one gradient) and the
+    elements, in id order."""
+    ids: dict[int, str] = {}
+    seen: dict[str, str] = {}
+    elements: list[str] = []
+    for index, paint in enumerate(paints):
+        if isinstance(paint, FlatPaint):
+            continue
+        text = gradient_element(paint, "", precision)
+        if text not in seen:
+            seen[text] = f"g{len(seen)}"
+            elements.append(gradient_element(paint, seen[text], precision))
+        ids[index] = seen[text]
+    return ids, elements
 
 
 def gradient_element(paint: Paint, identifier: str, precision: int) -> str:

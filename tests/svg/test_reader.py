@@ -124,8 +124,14 @@ def test_golden_samvg_files_read_back_exactly(name):
     path_data = re.findall(r'<path d="([^"]+)"', text)
     assert len(parsed.paths) == len(path_data)
     for data, (points, _) in zip(path_data, parsed.paths, strict=True):
-        numbers = [float(v) for v in re.findall(r"-?\d+(?:\.\d+)?", data)]
-        assert np.array_equal(points, np.array(numbers[:-2], dtype=np.float64).reshape(-1, 2))
+        # "M x y c" then relative cubics: offsets from each segment's start, in hundredths
+        numbers = [round(100 * float(v)) for v in re.findall(r"-?(?:\d+(?:\.\d*)?|\.\d+)", data)]
+        steps = np.array(numbers[2:], dtype=np.int64).reshape(-1, 3, 2)
+        starts = numbers[:2] + np.cumsum(np.concatenate([[[0, 0]], steps[:-1, 2]]), axis=0)
+        absolute = (steps + starts[:, None, :]).reshape(-1, 2)
+        expected = np.concatenate([[numbers[:2]], absolute[:-1]]) / 100
+        np.testing.assert_allclose(points, expected, rtol=0, atol=1e-9)
+        assert np.array_equal(starts[-1] + steps[-1, 2], numbers[:2])  # closed at the start
 
 
 # ---------------------------------------------------------------------- path commands

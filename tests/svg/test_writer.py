@@ -1,0 +1,50 @@
+"""Tests of samvg.svg.writer: compact path data that reads back to exactly the rounded points,
+and one gradient element per distinct gradient."""
+
+import re
+
+import numpy as np
+
+from samvg.scene import FlatPaint, LinearGradient, RadialGradient, Scene
+from samvg.svg.reader import read_svg
+from samvg.svg.writer import path_data, scene_to_svg
+
+
+def test_numbers_are_short_and_steps_relative():
+    points = np.array(
+        [[10.5, 20.25], [10.0, 19.75], [9.04, 20.0], [12.0, 20.0], [13.5, 21.0], [11.0, 22.0]]
+    )
+    # steps from (10.5, 20.25): (-.5, -.5) (-1.46, -.25) (1.5, -.25); then from (12, 20): ...
+    assert path_data(points, 2) == "M10.5 20.25c-.5-.5-1.46-.25 1.5-.25 1.5 1-1 2-1.5 .25z"
+
+
+def test_precision_zero_writes_integers():
+    points = np.array([[1.4, 2.6], [3.0, 4.0], [5.5, 6.0]])
+    assert path_data(points, 0) == "M1 3c2 1 5 3 0 0z"
+
+
+def test_read_back_equals_the_rounded_points():
+    rng = np.random.default_rng(0)
+    points = rng.uniform(-50, 550, (4, 12, 2))
+    offsets = np.arange(5) * 12
+    paints = tuple(FlatPaint((0.2, 0.4, 0.6, 1.0)) for _ in range(4))
+    scene = Scene(512, 512, points.reshape(-1, 2), offsets, paints)
+    for precision in (0, 1, 2, 3):
+        parsed = read_svg(scene_to_svg(scene, precision))
+        read = np.concatenate([p for p, _ in parsed.paths])
+        np.testing.assert_allclose(read, np.round(scene.points, precision), rtol=0, atol=1e-9)
+
+
+def test_identical_gradients_share_one_element():
+    square = np.array([[0, 0], [5, 0], [10, 0], [10, 5], [10, 10], [0, 10]], dtype=float)
+    stops = ((0.0, (1.0, 0.0, 0.0)), (1.0, (0.0, 0.0, 1.0)))
+    ramp = LinearGradient(stops=stops, start=(0.0, 0.0), end=(10.0, 0.0))
+    disc = RadialGradient(stops=stops, centre=(5.0, 5.0), radius=4.0)
+    paints = (ramp, FlatPaint((0.0, 1.0, 0.0, 1.0)), disc, ramp)
+    scene = Scene(12, 12, np.concatenate([square] * 4), np.arange(5) * 6, paints)
+    text = scene_to_svg(scene)
+    assert len(re.findall(r"<(?:linear|radial)Gradient ", text)) == 2
+    assert re.findall(r'fill="([^"]+)"', text) == ["url(#g0)", "#00ff00", "url(#g1)", "url(#g0)"]
+    fills = [fill for _, fill in read_svg(text).paths]
+    assert fills[0] == fills[3] and isinstance(fills[0], LinearGradient)
+    assert isinstance(fills[2], RadialGradient)
