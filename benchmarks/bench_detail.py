@@ -190,12 +190,20 @@ def main() -> None:
         help="budget records' folder, written by budget and read by report (bench_speed.py's "
         "time-against-paths plot reads benchmarks/results/speed/paths)",
     )
+    parser.add_argument(
+        "--geometry",
+        type=Path,
+        action="append",
+        help="report: a folder of bench_geometry.py's default records, samvg against VTracer, "
+        "one table each (default: benchmarks/results/geometry)",
+    )
     arguments = parser.parse_args()
     overrides = dict(_setting(text) for text in arguments.set)
     if arguments.study == "report":
         from detail_report import write_report
 
-        write_report(RECORDS, GEOMETRY, arguments.records if arguments.records != RECORDS else None)
+        budget = arguments.records if arguments.records != RECORDS else None
+        write_report(RECORDS, arguments.geometry or [GEOMETRY], budget)
         return
     categories = arguments.categories.split(",") if arguments.categories else None
     if arguments.study == "rate" and categories is None:

@@ -214,6 +214,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=REPO / "benchmarks/results/geometry")
     parser.add_argument("--per-category", type=int)
+    parser.add_argument("--categories", help="comma-separated (default: all six)")
     parser.add_argument("--settings", default="default,fixed5")
     parser.add_argument("--report", type=Path, default=REPO / "benchmarks/results/geometry.md")
     parser.add_argument("--report-only", action="store_true")
@@ -224,7 +225,8 @@ def main() -> None:
     names = arguments.settings.split(",")
     shard, shards = (int(part) for part in arguments.shard.split("/"))
     if not arguments.report_only:
-        entries = bench_entries(arguments.per_category)[shard::shards]
+        categories = arguments.categories.split(",") if arguments.categories else None
+        entries = bench_entries(arguments.per_category, categories)[shard::shards]
         run_all(entries, arguments.out, names)
     write_report(arguments.out, names, arguments.report)
 

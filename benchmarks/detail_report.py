@@ -35,7 +35,8 @@ def default_table(geometry: Path) -> list[str]:
     lines = [
         f"## The default against VTracer's default settings ({len(rows)} of 75 images)",
         "",
-        "Records from `python benchmarks/bench_geometry.py --settings default` (which also counts "
+        f"Records in `{_shown(geometry)}` from `python benchmarks/bench_geometry.py --settings "
+        "default` (which also counts "
         "the geometry of issue 12, see `geometry.md`). A *win* is MSE ≤ VTracer's, LPIPS ≤ "
         f"VTracer's + {LPIPS_SLACK} and SVG bytes ≤ {BYTES_SHARE:.2f} × VTracer's (the issue's "
         "goal: wins on ≥ 80 % of the emoji, icon, clipart and digital-art images).",
@@ -257,8 +258,11 @@ def rate_plot(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
-def write_report(records_folder: Path, geometry: Path, budget_folder: Path | None = None) -> None:
-    """detail.md from the records: the default against VTracer (``geometry``), the equal-budget
+def write_report(
+    records_folder: Path, geometry: list[Path], budget_folder: Path | None = None
+) -> None:
+    """detail.md from the records: the default against VTracer (a table per folder of
+    ``geometry``), the equal-budget
     tables (``budget_folder``, else the budget records of ``records_folder``), the gradient
     table and the rate-distortion plot (``records_folder``)."""
     records = _records(records_folder, "*.json")
@@ -270,7 +274,7 @@ def write_report(records_folder: Path, geometry: Path, budget_folder: Path | Non
         "All images at 512 px on this machine (2 cores, shared); MSE and LPIPS (AlexNet) at the "
         "working size; SVG bytes as written.",
         "",
-        *default_table(geometry),
+        *[line for folder in geometry for line in (*default_table(folder), "")],
         "",
         *budget_tables(budget_records, budget_folder),
         *gradient_table(records),

@@ -330,24 +330,33 @@ def row_bands(box: np.ndarray, height: int, parts: int) -> np.ndarray:
             work[box[p, 1]] += box[p, 2] + 1
             work[box[p, 1] + box[p, 3]] -= box[p, 2] + 1
     row_work = np.empty(height, np.float64)
-    total = 0.0
     running = 0.0
     for y in range(height):
         running += work[y]
         row_work[y] = running + 1.0  # the background fill and the row itself
-        total += row_work[y]
-    bands = np.empty(parts + 1, np.int64)
-    bands[0] = 0
-    bands[parts] = height
+    return _split_work(row_work, parts)
+
+
+@njit(cache=True, nogil=True)
+def _split_work(work: np.ndarray, parts: int) -> np.ndarray:
+    """``parts + 1`` boundaries that cut the items of ``work`` (their costs, in order) into
+    ``parts`` consecutive runs of about equal cost (a run may be empty)."""
+    count = work.shape[0]
+    total = 0.0
+    for i in range(count):
+        total += work[i]
+    bounds = np.empty(parts + 1, np.int64)
+    bounds[0] = 0
+    bounds[parts] = count
     done = 0.0
-    y = 0
+    item = 0
     for i in range(1, parts):
         goal = total * i / parts
-        while y < height and done + row_work[y] <= goal:
-            done += row_work[y]
-            y += 1
-        bands[i] = max(y, bands[i - 1])
-    return bands
+        while item < count and done + work[item] <= goal:
+            done += work[item]
+            item += 1
+        bounds[i] = max(item, bounds[i - 1])
+    return bounds
 
 
 @njit(cache=True, nogil=True)
@@ -735,22 +744,9 @@ def path_bands(box: np.ndarray, path_vstart: np.ndarray, parts: int) -> np.ndarr
     """``parts + 1`` path boundaries that split the edge pass into runs of about equal work."""
     n_paths = box.shape[0]
     work = np.empty(n_paths, np.float64)
-    total = 0.0
     for p in range(n_paths):
         work[p] = path_vstart[p + 1] - path_vstart[p] + box[p, 2] + box[p, 3] + 1.0
-        total += work[p]
-    bands = np.empty(parts + 1, np.int64)
-    bands[0] = 0
-    bands[parts] = n_paths
-    done = 0.0
-    p = 0
-    for i in range(1, parts):
-        goal = total * i / parts
-        while p < n_paths and done + work[p] <= goal:
-            done += work[p]
-            p += 1
-        bands[i] = max(p, bands[i - 1])
-    return bands
+    return _split_work(work, parts)
 
 
 @njit(cache=True, nogil=True)
