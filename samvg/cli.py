@@ -32,7 +32,7 @@ from samvg.config import Config
 from samvg.errors import InputError, OutputError, SamvgError
 from samvg.io import read_image, write_png
 from samvg.output_paths import batch_outputs, check_output_file, check_output_folder
-from samvg.svg.writer import check_precision
+from samvg.svg.writer import DEFAULT_PRECISION, check_precision
 from samvg.vector_image import VectorImage
 
 if TYPE_CHECKING:  # the pipeline loads torch and numba: imported when a command needs it
@@ -507,7 +507,10 @@ def _add_vectorize_command(commands: Any) -> None:
     vectorize.add_argument("--fast", action="store_true", help="same as --preset fast")
     _add_tuning_options(vectorize)
     vectorize.add_argument(
-        "--precision", type=int, default=2, help="decimals in SVG output, 0 to 10 (default 2)"
+        "--precision",
+        type=int,
+        default=DEFAULT_PRECISION,
+        help=f"decimals in SVG output, 0 to 10 (default {DEFAULT_PRECISION})",
     )
     vectorize.add_argument(
         "--overwrite", action="store_true", help="in a batch, redo images whose SVG already exists"

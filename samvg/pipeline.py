@@ -42,6 +42,7 @@ from samvg.render.threads import using_render_threads
 from samvg.sam import SPECS
 from samvg.scene import FlatPaint, Frame, Scene
 from samvg.segment import Segmenter, SegmentSettings, select_masks
+from samvg.svg.writer import DEFAULT_PRECISION
 from samvg.trace.stage import (
     TraceSettings,
     drop_transparent,
@@ -56,8 +57,6 @@ ProgressCallback = Callable[[str, int, int], None]
 LogCallback = Callable[[str], None]
 
 UNIFORM_TOLERANCE = 1.5 / 255.0
-#: Decimals of the coordinates `VectorImage.save` writes by default.
-SAVE_PRECISION = 2
 MIN_WORKING_SIDE = 8
 
 
@@ -460,7 +459,7 @@ def _finish_note(counts: dict[str, int]) -> str:
     )
 
 
-def simple_when_saved(scene: Scene, precision: int = SAVE_PRECISION) -> Scene:
+def simple_when_saved(scene: Scene, precision: int = DEFAULT_PRECISION) -> Scene:
     """``scene`` (input pixels) with coordinates rounded as the SVG will hold them, repairing a
     path that rounding makes cross itself (two stretches of an outline closer than the
     rounding step now touch)."""

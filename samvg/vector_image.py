@@ -18,7 +18,7 @@ from samvg.errors import InputError
 from samvg.io import atomic_write_text
 from samvg.scene import RGB, RGBA, FlatPaint, Scene
 from samvg.svg.reader import read_svg
-from samvg.svg.writer import scene_to_svg
+from samvg.svg.writer import DEFAULT_PRECISION, scene_to_svg
 
 
 @dataclass
@@ -95,11 +95,11 @@ class VectorImage:
         )
 
     # ------------------------------------------------------------------ output
-    def to_svg(self, precision: int = 2) -> str:
+    def to_svg(self, precision: int = DEFAULT_PRECISION) -> str:
         """SVG text: width, height, viewBox, an optional background rect and one path each."""
         return scene_to_svg(self._scene, precision)
 
-    def save(self, path: str | os.PathLike[str], precision: int = 2) -> None:
+    def save(self, path: str | os.PathLike[str], precision: int = DEFAULT_PRECISION) -> None:
         """Write :meth:`to_svg` to ``path`` atomically (temporary file, then rename)."""
         atomic_write_text(path, self.to_svg(precision))
 

@@ -7,8 +7,9 @@ optimization of crossing paths lets last-bit differences grow into visibly diffe
 So every machine checks what carries over (the same paths, each image as close to its target
 as the golden one, rendered by resvg), and the machine the files were written on (named in
 ``tests/data/golden/MACHINE``) also checks the bytes. The files were last written on
-2026-12-03 at the commit after 65cf37a, on the CI machine of that day; the runs pin the
-rasterizer to one thread, whose colour-gradient sums are those of the single-threaded kernels.
+2026-12-03, with one decimal (the writer's default since), on the CI machine of that day; the
+runs pin the rasterizer to one thread, whose colour-gradient sums are those of the
+single-threaded kernels.
 """
 
 import functools
