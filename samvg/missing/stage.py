@@ -13,6 +13,7 @@ import numpy as np
 
 from samvg.config import Config
 from samvg.imaging import error_map
+from samvg.missing.marks import MarkSettings, mark_groups
 from samvg.missing.prompts import missing_component_map, missing_component_prompts
 from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import StepCallback
@@ -51,6 +52,8 @@ class MissingSettings:
     """The automatic rounds stop when a round lowers the MSE by less than this fraction."""
     refit_scene: bool = True
     """Each round fits the whole scene (True) or only its new paths over the rest's render."""
+    marks: MarkSettings | None = None
+    """Also offer the groups of small marks on flat areas (None: no marks)."""
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> MissingSettings:
@@ -66,6 +69,7 @@ class MissingSettings:
             colour_split=colour_split_settings(config, width, height),
             gain_tolerance=options.gain_tolerance,
             refit_scene=options.refit_scene,
+            marks=MarkSettings() if options.marks else None,
         )
 
 
@@ -89,10 +93,12 @@ def missing_masks(
     settings: MissingSettings,
     limit: int | None = None,
 ) -> list[np.ndarray]:
-    """SAM at the prompts, filtered by impact with the render I′ as the starting canvas; at
-    most ``limit`` of them (those with the largest impact), returned largest first (they are
-    painted on top of the scene)."""
+    """SAM at the prompts (and the regions and marks the render gets wrong), filtered by impact
+    with the render I′ as the starting canvas; at most ``limit`` of them (those with the largest
+    impact), returned largest first, groups of marks last (they are painted on top of the scene
+    in this order)."""
     canvas = ImpactCanvas(target, settings.impact_threshold, start=render)
+    lab = None
     offer_best(
         canvas,
         segmenter.prompt(prompts),
@@ -104,11 +110,19 @@ def missing_masks(
         lab = lab_image(target)
         offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact, False, lab)
         offer_wrong_regions(canvas, render, settings.pixel_error, settings.colour_split, lab)
-    masks = canvas.kept_masks
-    if limit is not None and len(masks) > limit:
-        order = np.argsort(-np.asarray(canvas.impacts), kind="stable")[:limit]
-        masks = [masks[index] for index in sorted(order)]
-    return sorted(masks, key=lambda mask: -int(mask.sum()))
+    regions = len(canvas.kept_masks)
+    if settings.marks is not None:
+        lab = lab_image(target) if lab is None else lab
+        for group in mark_groups(target, render, lab, settings.marks):
+            canvas.offer(group)
+    order: list[int] = list(range(len(canvas.kept_masks)))
+    if limit is not None and len(order) > limit:
+        order = sorted(
+            int(i) for i in np.argsort(-np.asarray(canvas.impacts), kind="stable")[:limit]
+        )
+    # regions largest first, then the groups of marks, which lie on top of everything
+    order = sorted(order, key=lambda i: (i >= regions, -int(canvas.kept_masks[i].sum())))
+    return [canvas.kept_masks[i] for i in order]
 
 
 def offer_wrong_regions(
@@ -157,6 +171,8 @@ def add_missing(
     prompts = missing_component_prompts(averaged, above)
     room = room_left(scene, settings)
     masks = [] if room == 0 else missing_masks(segmenter, prompts, target, render, settings, room)
+    if settings.marks is not None:
+        trace = replace(trace, min_pixels=min(trace.min_pixels, settings.marks.min_pixels))
     added = trace_scene(drop_transparent(masks, alpha), target, trace)
     if room is not None and added.path_count > room:
         added = added.subset(range(room))

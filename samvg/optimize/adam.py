@@ -14,19 +14,23 @@ import torch
 
 
 class Adam:
-    """Adam (Kingma & Ba) over groups of tensors, one learning rate per group.
+    """Adam (Kingma & Ba) over groups of tensors, one learning rate per group: a number, or a
+    tensor that broadcasts against each of the group's tensors (a rate per element).
 
-    The arithmetic is that of ``torch.optim.Adam``'s single-tensor path (the CPU default), so a
-    fit gives the same numbers with either.
+    With numbers the arithmetic is that of ``torch.optim.Adam``'s single-tensor path (the CPU
+    default), so a fit gives the same numbers with either.
     """
 
     def __init__(
         self,
-        groups: Sequence[tuple[Sequence[torch.Tensor], float]],
+        groups: Sequence[tuple[Sequence[torch.Tensor], float | torch.Tensor]],
         betas: tuple[float, float] = (0.9, 0.999),
         eps: float = 1e-8,
     ) -> None:
-        self.groups = [(list(tensors), float(rate)) for tensors, rate in groups]
+        self.groups = [
+            (list(tensors), rate if isinstance(rate, torch.Tensor) else float(rate))
+            for tensors, rate in groups
+        ]
         self.betas = betas
         self.eps = eps
         self.steps = 0
@@ -53,4 +57,7 @@ class Adam:
                 mean.lerp_(tensor.grad, 1 - beta1)
                 square.mul_(beta2).addcmul_(tensor.grad, tensor.grad, value=1 - beta2)
                 denominator = (square.sqrt() / correction2_root).add_(self.eps)
-                tensor.addcdiv_(mean, denominator, value=-rate / correction1)
+                if isinstance(rate, torch.Tensor):
+                    tensor.sub_(mean / denominator * (rate / correction1))
+                else:
+                    tensor.addcdiv_(mean, denominator, value=-rate / correction1)
