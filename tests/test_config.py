@@ -106,3 +106,10 @@ def test_speed_settings_are_checked_and_the_paper_fits_exactly():
     for bad in ({"lpips_every": 0}, {"coarse_fraction": 1.5}, {"coarse_fraction": -0.1}):
         with pytest.raises(InputError, match="lpips every|coarse fraction"):
             Config(**bad)
+
+
+def test_marks_and_still_small_paths_are_the_default_and_not_the_papers():
+    assert Config().missing.marks and not Config.paper().missing.marks
+    assert Config().fit.small_path_size == 16.0 and Config.paper().fit.small_path_size is None
+    with pytest.raises(InputError, match="small_path_size|small path size"):
+        Config(small_path_size=-1.0)

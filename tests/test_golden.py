@@ -119,4 +119,3 @@ def test_svg_bytes_match_the_golden_files_on_their_machine(run):
         pytest.skip(f"golden bytes were written on {golden_machine()}, this is {this_machine()}")
     svg, expected = run
     assert svg == expected
-

@@ -31,3 +31,17 @@ def test_adam_matches_torch_step_for_step():
         assert torch.equal(mine, reference)
     assert torch.equal(ours[2], torch.zeros(3))
     assert not torch.equal(ours[0], _quadratic_steps(lambda p, c, u: Adam([([p], 0.5)]), 0)[0])
+
+
+def test_a_rate_per_element_matches_the_number_and_zero_freezes():
+    ones = torch.ones(7, 1)
+    by_number = _quadratic_steps(lambda p, c, u: Adam([([p, u], 0.5), ([c], 0.01)]))
+    by_tensor = _quadratic_steps(lambda p, c, u: Adam([([p], 0.5 * ones), ([c], 0.01)]))
+    assert torch.allclose(by_number[0], by_tensor[0], atol=1e-6)
+    frozen = torch.ones(7, 1)
+    frozen[2:4] = 0.0
+    moved = _quadratic_steps(lambda p, c, u: Adam([([p], 0.5 * frozen), ([c], 0.01)]))
+    torch.manual_seed(3)
+    start = torch.randn(7, 2)
+    assert torch.equal(moved[0][2:4], start[2:4])
+    assert not torch.equal(moved[0][:2], start[:2])
