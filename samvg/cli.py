@@ -148,6 +148,7 @@ def _config(arguments: argparse.Namespace) -> Config:
         "detail": arguments.detail,
         "tolerance": arguments.tolerance,
         "colors": arguments.colors,
+        "filter_speckle": arguments.filter_speckle,
     }
     settings.update({key: value for key, value in optional.items() if value is not None})
     if arguments.no_lpips:
@@ -425,6 +426,12 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
     )
     vectorize.add_argument(
         "--colors", type=int, help="snap the fills to this many colours (k-means in CIELAB)"
+    )
+    vectorize.add_argument(
+        "--filter-speckle",
+        type=int,
+        help="small marks on flat areas (a texture's dashes) smaller than N x N working pixels "
+        "are left out (default 4, as VTracer)",
     )
     vectorize.add_argument(
         "--translucent",

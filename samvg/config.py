@@ -244,6 +244,9 @@ class MissingOptions:
     marks: bool = True
     """Also add the small marks of one colour on flat areas (a texture's dashes and dots) that
     no SAM prompt segments, each group of marks judged by impact as a whole."""
+    filter_speckle: int = 4
+    """Marks smaller than this many pixels squared (working pixels) are speckle and never become
+    paths: VTracer's ``filter_speckle``, and its default."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015
@@ -262,6 +265,7 @@ class MissingOptions:
             or not (0.0 <= self.detail <= 1.0)
         ):
             raise InputError(f"detail must be a number from 0 to 1, got {self.detail!r}")
+        _check_integer(self, "filter_speckle", 1)
         _check_non_negative(self, "missing_threshold")
         _check_non_negative(self, "missing_impact_threshold")
         _check_radius(self, "missing_radius")

@@ -379,6 +379,9 @@ CASES: dict[str, Case] = {
     "max-paths-0": Case([*VEC, "--max-paths", "0"], "max paths must be a positive integer", IMG),
     "paths-0": Case([*VEC, "--paths", "0"], "paths must be an integer >= 1", IMG),
     "detail-above-1": Case([*VEC, "--detail", "2"], "detail must be a number from 0 to 1", IMG),
+    "filter-speckle-0": Case(
+        [*VEC, "--filter-speckle", "0"], "filter speckle must be an integer >= 1", IMG
+    ),
     "size-too-small": Case([*VEC, "--size", "4"], "size must be an integer >= 8", IMG),
     "output-option-missing": Case(["in.png"], "required: -o/--output", IMG, code=2),
 }

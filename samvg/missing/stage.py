@@ -69,7 +69,7 @@ class MissingSettings:
             colour_split=colour_split_settings(config, width, height),
             gain_tolerance=options.gain_tolerance,
             refit_scene=options.refit_scene,
-            marks=MarkSettings() if options.marks else None,
+            marks=MarkSettings(min_pixels=options.filter_speckle**2) if options.marks else None,
         )
 
 
