@@ -4,6 +4,7 @@ N paths], one row per bench image, with path counts, MSE and SVG bytes under eac
     python benchmarks/contact_sheet.py --per-category 2 --preset fast --output sheet.png
     python benchmarks/contact_sheet.py --per-category 2 --preset default --budget 64 --output s.png
     python benchmarks/contact_sheet.py --svg-dir svgs/ --categories digital_art --output g.png
+    python benchmarks/contact_sheet.py --ids gnome_field_l,noto_cactus --preset default -o f.png
 
 ``--svg-dir`` draws SVGs written earlier (``bench_detail.py --keep-svg``) instead of running
 samvg: one column per ``<id>.<tag>.svg`` file of the image, in name order, then VTracer's.
@@ -112,15 +113,24 @@ def main() -> None:
     parser.add_argument("--per-category", type=int, default=2)
     parser.add_argument("--categories", default="emoji,icon,clipart,digital_art")
     parser.add_argument("--preset", choices=sorted(PRESETS), default="fast")
-    parser.add_argument("--output", type=Path, required=True)
+    parser.add_argument("-o", "--output", type=Path, required=True)
     parser.add_argument("--budget", type=int, help="add a column: samvg with --paths N")
     parser.add_argument("--svg-dir", type=Path, help="draw saved SVGs instead of running samvg")
+    parser.add_argument("--ids", help="comma-separated bench ids instead of --per-category")
     arguments = parser.parse_args()
     wanted = arguments.categories.split(",")
     if arguments.output.resolve().is_relative_to(REPO) and {"photo", "painting"} & set(wanted):
         sys.exit("photo and painting sheets stay out of the repository: write them elsewhere")
     config = PRESETS[arguments.preset]()
-    entries = bench_entries(arguments.per_category, wanted)
+    if arguments.ids:
+        ids = arguments.ids.split(",")
+        by_id = {entry["id"]: entry for entry in bench_entries(None, wanted)}
+        missing = [name for name in ids if name not in by_id]
+        if missing:
+            sys.exit(f"not in the bench (or not in --categories): {', '.join(missing)}")
+        entries = [by_id[name] for name in ids]
+    else:
+        entries = bench_entries(arguments.per_category, wanted)
     if arguments.svg_dir is not None:
         entries = [e for e in entries if any(arguments.svg_dir.glob(f"{e['id']}.*.svg"))]
         rows = [row_from_svgs(entry, arguments.svg_dir) for entry in entries]
