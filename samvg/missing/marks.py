@@ -13,12 +13,13 @@ or fails as a whole, and each of its components becomes a path of its own colour
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import ndimage
 
 from samvg.imaging import error_map
+from samvg.trace.stage import TraceSettings
 
 _OPENING = np.ones((2, 2), dtype=bool)
 _RING = np.ones((3, 3), dtype=bool)
@@ -38,6 +39,17 @@ class MarkSettings:
     """ΔE (CIELAB) within which marks share a group's colour."""
     max_marks: int = 1024
     """The largest marks kept; the rest wait for a later round."""
+    tolerance: float = 0.75
+    """Pixels: marks are traced this closely (or as the stage's tolerance, if closer): a small
+    path keeps its traced outline through the fit (`FitSettings.small_path_size`)."""
+
+    def trace_settings(self, trace: TraceSettings) -> TraceSettings:
+        """``trace`` for marks: their smallest size and, with per-path segments, the closer
+        tolerance."""
+        tolerance = trace.tolerance
+        if tolerance is not None:
+            tolerance = min(tolerance, self.tolerance)
+        return replace(trace, min_pixels=self.min_pixels, tolerance=tolerance)
 
 
 def mark_groups(

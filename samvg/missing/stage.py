@@ -92,11 +92,11 @@ def missing_masks(
     render: np.ndarray,
     settings: MissingSettings,
     limit: int | None = None,
-) -> list[np.ndarray]:
+) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """SAM at the prompts (and the regions and marks the render gets wrong), filtered by impact
     with the render I′ as the starting canvas; at most ``limit`` of them (those with the largest
-    impact), returned largest first, groups of marks last (they are painted on top of the scene
-    in this order)."""
+    impact). Returns the regions, largest first, and the groups of marks, largest first: painted
+    on top of the scene in this order, the marks last."""
     canvas = ImpactCanvas(target, settings.impact_threshold, start=render)
     lab = None
     offer_best(
@@ -120,9 +120,11 @@ def missing_masks(
         order = sorted(
             int(i) for i in np.argsort(-np.asarray(canvas.impacts), kind="stable")[:limit]
         )
-    # regions largest first, then the groups of marks, which lie on top of everything
-    order = sorted(order, key=lambda i: (i >= regions, -int(canvas.kept_masks[i].sum())))
-    return [canvas.kept_masks[i] for i in order]
+    order = sorted(order, key=lambda i: -int(canvas.kept_masks[i].sum()))
+    return (
+        [canvas.kept_masks[i] for i in order if i < regions],
+        [canvas.kept_masks[i] for i in order if i >= regions],
+    )
 
 
 def offer_wrong_regions(
@@ -170,10 +172,13 @@ def add_missing(
     averaged, above = missing_component_map(target, render, settings.radius, settings.threshold)
     prompts = missing_component_prompts(averaged, above)
     room = room_left(scene, settings)
-    masks = [] if room == 0 else missing_masks(segmenter, prompts, target, render, settings, room)
-    if settings.marks is not None:
-        trace = replace(trace, min_pixels=min(trace.min_pixels, settings.marks.min_pixels))
-    added = trace_scene(drop_transparent(masks, alpha), target, trace)
+    regions, marks = (
+        ([], []) if room == 0 else missing_masks(segmenter, prompts, target, render, settings, room)
+    )
+    added = trace_scene(drop_transparent(regions, alpha), target, trace)
+    if marks and settings.marks is not None:
+        fine = settings.marks.trace_settings(trace)
+        added = added.stacked(trace_scene(drop_transparent(marks, alpha), target, fine))
     if room is not None and added.path_count > room:
         added = added.subset(range(room))
     result = MissingRound(scene, averaged, prompts, added.path_count)

@@ -4,9 +4,12 @@ one-pixel seams, speckle and misplaced edges are not marks; stage 4 paints the g
 import numpy as np
 from scipy import ndimage
 
-from samvg.missing import MissingSettings, missing_masks
+from samvg.missing import MissingSettings, add_missing, missing_masks
 from samvg.missing.marks import MarkSettings, mark_groups
+from samvg.optimize import FitSettings
+from samvg.scene import Scene
 from samvg.segment.colour_split import lab_image
+from samvg.trace.stage import TraceSettings
 
 GREEN = (0.13, 0.6, 0.38)
 LIGHT = (0.2, 0.78, 0.5)
@@ -82,18 +85,18 @@ def test_stage_four_offers_the_marks_and_paints_them_last():
         rounds=1,
         marks=MarkSettings(),
     )
-    masks = missing_masks(NoSegmenter(), np.zeros((0, 2)), target, flat_render(), settings)
-    assert len(masks) == 1 and ndimage.label(masks[-1])[1] == len(DASHES)
+    regions, marks = missing_masks(NoSegmenter(), np.zeros((0, 2)), target, flat_render(), settings)
+    assert regions == [] and len(marks) == 1 and ndimage.label(marks[0])[1] == len(DASHES)
     without = missing_masks(
         NoSegmenter(), np.zeros((0, 2)), target, flat_render(), MissingSettings(
             radius=1.0, threshold=0.5, impact_threshold=1e-5, filter_by_impact=True,
             min_pixels=50, rounds=1,
         )
     )  # fmt: skip
-    assert without == []
+    assert without == ([], [])
 
 
-def test_regions_come_first_and_the_marks_on_top():
+def test_regions_and_marks_come_apart():
     class SquareSegmenter:
         def prompt(self, points: np.ndarray) -> list[list[np.ndarray]]:
             mask = np.zeros((96, 96), bool)
@@ -112,5 +115,36 @@ def test_regions_come_first_and_the_marks_on_top():
         marks=MarkSettings(),
     )
     prompts = np.array([[90.0, 90.0]])
-    masks = missing_masks(SquareSegmenter(), prompts, target, flat_render(), settings)
-    assert [int(mask.sum()) for mask in masks] == [144, 20 * len(DASHES)]
+    regions, marks = missing_masks(SquareSegmenter(), prompts, target, flat_render(), settings)
+    assert [int(mask.sum()) for mask in regions] == [144]
+    assert [int(mask.sum()) for mask in marks] == [20 * len(DASHES)]
+
+
+def test_marks_are_traced_closely_and_kept_when_small():
+    trace = TraceSettings(segments=4, min_pixels=50, tolerance=2.0)
+    fine = MarkSettings(min_pixels=9).trace_settings(trace)
+    assert (fine.min_pixels, fine.tolerance) == (9, 0.75)
+    fixed = MarkSettings().trace_settings(TraceSettings(segments=5, min_pixels=50))
+    assert fixed.tolerance is None and fixed.segments == 5
+
+
+def test_a_round_of_stage_four_adds_a_path_for_each_mark():
+    class NoSegmenter:
+        def prompt(self, points: np.ndarray) -> list[list[np.ndarray]]:
+            return [[] for _ in points]
+
+    target = field({spot: LIGHT for spot in DASHES})
+    settings = MissingSettings(
+        radius=1.0,
+        threshold=0.5,
+        impact_threshold=1e-5,
+        filter_by_impact=True,
+        min_pixels=50,
+        rounds=1,
+        marks=MarkSettings(),
+    )
+    scene = Scene(96, 96, background=GREEN)
+    trace = TraceSettings(4, 50, tolerance=2.0)
+    done = add_missing(scene, target, NoSegmenter(), settings, trace, FitSettings(steps=0))
+    assert done.added == len(DASHES)
+    assert np.abs(done.scene.render() - target).mean() < np.abs(scene.render() - target).mean() / 4

@@ -60,9 +60,10 @@ PROMPTS = np.array([[10.0, 10.0], [45.0, 10.0], [10.0, 45.0]])
 
 def test_missing_masks_keep_the_largest_impact_within_the_limit():
     white = np.ones((64, 64, 3), np.float32)
-    every = missing_masks(FakeSegmenter(), PROMPTS, target(), white, settings(None))
+    every, marks = missing_masks(FakeSegmenter(), PROMPTS, target(), white, settings(None))
+    assert marks == []
     assert [int(mask.sum()) for mask in every] == [400, 196, 64]
-    two = missing_masks(FakeSegmenter(), PROMPTS, target(), white, settings(None), limit=2)
+    two, _ = missing_masks(FakeSegmenter(), PROMPTS, target(), white, settings(None), limit=2)
     assert [int(mask.sum()) for mask in two] == [400, 196]  # the two that remove most error
 
 
