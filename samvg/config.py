@@ -146,10 +146,6 @@ class FitOptions:
     (at most ``iterations``) on MSE + Xing, half of them at half size; they only have to place
     the paths for the next error map. The fit at the end has ``iterations`` steps."""
     point_learning_rate: float = 1.0
-    small_path_size: float | None = 16.0
-    """Pixels: a path smaller than this (the square root of its control polygon's area) keeps
-    its traced outline; only its colour is fitted. Adam's steps are about a pixel whatever the
-    gradient, which tears a two-pixel dash into a streak (None: every path moves, the paper)."""
     colour_learning_rate: float = 0.01
     xing_weight: float = 0.01
     use_lpips: bool = True
@@ -183,8 +179,6 @@ class FitOptions:
         _check_integer(self, "draft_iterations", 0)
         if self.margin is not None:
             _check_non_negative(self, "margin")
-        if self.small_path_size is not None:
-            _check_non_negative(self, "small_path_size")
         _check_integer(self, "lpips_size", 32)
         _check_integer(self, "lpips_every", 1)
         _check_non_negative(self, "coarse_fraction")
@@ -412,7 +406,6 @@ PAPER: dict[str, Any] = {
     "finish_pass": False,
     "colour_split": False,
     "marks": False,
-    "small_path_size": None,
     "missing_rounds": 1,
     "refit_scene": True,
     "gradients": False,

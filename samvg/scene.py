@@ -234,6 +234,9 @@ class Scene:
     background_gradient: BackgroundGradient | None = None
     """An opaque gradient drawn behind the paths; ``background`` is then its flat stand-in (the
     mean stop colour), whatever was given."""
+    fixed: np.ndarray | None = None
+    """(P,) bool: paths whose outline a fit leaves as traced (only their paint is fitted), or
+    None for none. Kept by `with_geometry`, `stacked` and `subset`; new paths start free."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "width", _check_canvas(self.width, "width"))
@@ -260,6 +263,11 @@ class Scene:
         object.__setattr__(self, "background_gradient", gradient)
         background = self.background if gradient is None else gradient.rgba[:3]
         object.__setattr__(self, "background", _check_background(background))
+        if self.fixed is not None:
+            fixed = np.asarray(self.fixed, dtype=bool)
+            if fixed.shape != (len(counts),):
+                raise InputError(f"{len(counts)} paths but {len(fixed)} fixed flags")
+            object.__setattr__(self, "fixed", fixed if fixed.any() else None)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -363,9 +371,8 @@ class Scene:
         """These (points (3K, 2), paint) pairs, in paint order, in place of this scene's paths
         (canvas, background and frame kept)."""
         points, offsets = _pack(paths)
-        return replace(
-            self, points=points, offsets=offsets, paints=tuple(paint for _, paint in paths)
-        )
+        paints = tuple(paint for _, paint in paths)
+        return replace(self, points=points, offsets=offsets, paints=paints, fixed=None)
 
     def with_background(self, background: Sequence[float] | None) -> Scene:
         """The scene over a flat ``background`` (None: white); a background gradient goes."""
@@ -380,11 +387,22 @@ class Scene:
             points=np.concatenate([self.points, above.points]),
             offsets=np.concatenate([self.offsets, above.offsets[1:] + len(self.points)]),
             paints=self.paints + above.paints,
+            fixed=np.concatenate([self.fixed_paths(), above.fixed_paths()]),
         )
 
     def subset(self, keep: Sequence[int] | np.ndarray) -> Scene:
         """Only the paths at indices ``keep`` (in the order given)."""
-        return self.with_paths([(self.path_points(int(i)), self.paints[int(i)]) for i in keep])
+        kept = self.with_paths([(self.path_points(int(i)), self.paints[int(i)]) for i in keep])
+        indices = np.asarray(keep, dtype=np.int64)
+        return replace(kept, fixed=self.fixed_paths()[indices] if len(indices) else None)
+
+    def fixed_paths(self) -> np.ndarray:
+        """(P,) bool: which paths keep their outline in a fit (`fixed`, all False when None)."""
+        return np.zeros(self.path_count, bool) if self.fixed is None else self.fixed
+
+    def with_fixed_outlines(self) -> Scene:
+        """This scene with every path's outline fixed (its paint still fitted)."""
+        return replace(self, fixed=np.ones(self.path_count, bool))
 
     def in_input_pixels(self) -> Scene:
         """The scene on the input canvas (``frame``), coordinates divided by its scale."""

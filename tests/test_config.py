@@ -108,8 +108,6 @@ def test_speed_settings_are_checked_and_the_paper_fits_exactly():
             Config(**bad)
 
 
-def test_marks_and_still_small_paths_are_the_default_and_not_the_papers():
+def test_marks_are_the_default_and_not_the_papers():
     assert Config().missing.marks and not Config.paper().missing.marks
-    assert Config().fit.small_path_size == 16.0 and Config.paper().fit.small_path_size is None
-    with pytest.raises(InputError, match="small_path_size|small path size"):
-        Config(small_path_size=-1.0)
+    assert Config().missing.filter_speckle == 4

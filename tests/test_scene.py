@@ -1,5 +1,7 @@
 """The scene type: ragged packed paths, paints, background and the frame to input pixels."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -100,3 +102,16 @@ def test_a_background_gradient_is_kept_by_every_derived_scene():
     assert flat.background_gradient is None and flat.background == (0.0, 1.0, 0.0)
     rendered = Scene(40, 20, background_gradient=ramp).render()
     assert rendered[10, 0, 0] > 0.9 and rendered[10, -1, 2] > 0.9  # red to blue, left to right
+
+
+def test_fixed_outlines_follow_their_paths():
+    one = Scene.from_paths(32, 32, [(square(2, 2, 8), FlatPaint((1.0, 0.0, 0.0)))])
+    free = Scene.from_paths(32, 32, [(square(12, 12, 8), FlatPaint((0.0, 0.0, 1.0)))] * 2)
+    stacked = free.stacked(one.with_fixed_outlines())
+    assert list(stacked.fixed_paths()) == [False, False, True]
+    assert list(stacked.subset([2, 0]).fixed_paths()) == [True, False]
+    assert stacked.subset([0, 1]).fixed is None
+    assert stacked.with_geometry(stacked.points + 1).fixed is not None
+    assert stacked.with_paths(list(stacked.paths())).fixed is None
+    with pytest.raises(InputError, match="3 paths but 2 fixed flags"):
+        replace(stacked, fixed=np.array([True, False]))

@@ -8,7 +8,9 @@ flat. A misplaced edge is not a mark: the render changes colour there. Regions o
 pixels wide along the render's edges are the common false alarm, so the wrong pixels are first
 opened with a 2 × 2 square, which keeps strokes two pixels wide. Marks of one colour (within
 ``contrast`` ΔE in CIELAB) form one group, offered to the filter as one mask: a texture passes
-or fails as a whole, and each of its components becomes a path of its own colour.
+or fails as a whole, and each of its components becomes a path of its own colour, traced
+closely and kept as traced: Adam's steps are about a pixel whatever the gradient, which tears a
+two-pixel dash into a streak, so fits move only a mark's paint.
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ class MarkSettings:
     """The largest marks kept; the rest wait for a later round."""
     tolerance: float = 0.75
     """Pixels: marks are traced this closely (or as the stage's tolerance, if closer): a small
-    path keeps its traced outline through the fit (`FitSettings.small_path_size`)."""
+    mark keeps its traced outline through every fit (`Scene.fixed`)."""
 
     def trace_settings(self, trace: TraceSettings) -> TraceSettings:
         """``trace`` for marks: their smallest size and, with per-path segments, the closer

@@ -178,7 +178,8 @@ def add_missing(
     added = trace_scene(drop_transparent(regions, alpha), target, trace)
     if marks and settings.marks is not None:
         fine = settings.marks.trace_settings(trace)
-        added = added.stacked(trace_scene(drop_transparent(marks, alpha), target, fine))
+        traced = trace_scene(drop_transparent(marks, alpha), target, fine)
+        added = added.stacked(traced.with_fixed_outlines())
     if room is not None and added.path_count > room:
         added = added.subset(range(room))
     result = MissingRound(scene, averaged, prompts, added.path_count)

@@ -13,7 +13,6 @@ import torch
 
 from samvg.config import FitOptions
 from samvg.errors import InputError, SamvgError
-from samvg.finish.outline import polygon_areas
 from samvg.imaging import halve
 from samvg.optimize.adam import Adam
 from samvg.optimize.losses import PerceptualLoss, lpips_loss, segment_indices, xing_loss
@@ -50,9 +49,6 @@ class FitSettings:
     point_learning_rate: float = 1.0
     colour_learning_rate: float = 0.01
     xing_weight: float = 0.0
-    small_path_size: float | None = None
-    """Pixels: paths smaller than this keep their points where they are (`moving_points`);
-    their colours are still fitted. None: every path moves."""
     perceptual: PerceptualLoss | None = None
     perceptual_weight: float = 0.0
     learn_alpha: bool = True
@@ -92,7 +88,6 @@ class FitSettings:
         return cls(
             steps=options.iterations,
             point_learning_rate=options.point_learning_rate,
-            small_path_size=options.small_path_size,
             colour_learning_rate=options.colour_learning_rate,
             xing_weight=options.xing_weight,
             perceptual=perceptual,
@@ -192,14 +187,6 @@ class _GradientVariables:
         return self.current().paints(colours)
 
 
-def moving_points(scene: Scene, small_path_size: float) -> np.ndarray:
-    """(N,) float32: 1 for the control points of paths at least ``small_path_size`` pixels in
-    size (square root of the control polygon's area), 0 for the points of smaller ones."""
-    sizes = np.sqrt(polygon_areas(scene.points, scene.offsets))
-    moving = (sizes >= small_path_size).astype(np.float32)
-    return np.repeat(moving, np.diff(scene.offsets))
-
-
 class _Parameters:
     """What Adam moves: packed points, RGBA colours, the gradient paints of paths and a
     background gradient (see `_GradientVariables`; none with an ``underlay``)."""
@@ -235,12 +222,11 @@ class _Parameters:
             (point_group, settings.point_learning_rate),
             (colour_group, settings.colour_learning_rate),
         ]
-        if settings.small_path_size is not None:
-            moving = moving_points(self.scene, settings.small_path_size)
-            if float(moving.min(initial=1.0)) < 1.0:
-                rate = settings.point_learning_rate * torch.from_numpy(moving)[:, None]
-                groups = [(point_group[1:], settings.point_learning_rate), ([self.points], rate)]
-                groups.append((colour_group, settings.colour_learning_rate))
+        if self.scene.fixed is not None:  # fixed outlines: their points' rate is 0
+            moving = np.repeat(~self.scene.fixed, np.diff(self.scene.offsets)).astype(np.float32)
+            rate = settings.point_learning_rate * torch.from_numpy(moving)[:, None]
+            groups = [(point_group[1:], settings.point_learning_rate), ([self.points], rate)]
+            groups.append((colour_group, settings.colour_learning_rate))
         return Adam(groups)
 
     def render(self) -> torch.Tensor:

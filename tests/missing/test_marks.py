@@ -146,5 +146,5 @@ def test_a_round_of_stage_four_adds_a_path_for_each_mark():
     scene = Scene(96, 96, background=GREEN)
     trace = TraceSettings(4, 50, tolerance=2.0)
     done = add_missing(scene, target, NoSegmenter(), settings, trace, FitSettings(steps=0))
-    assert done.added == len(DASHES)
+    assert done.added == len(DASHES) and done.scene.fixed_paths().all()
     assert np.abs(done.scene.render() - target).mean() < np.abs(scene.render() - target).mean() / 4

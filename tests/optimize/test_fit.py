@@ -1,5 +1,7 @@
 """Tests of path fitting: the optimiser moves a misplaced shape onto its target and fixes colour."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -182,12 +184,14 @@ def test_the_gradient_choice_gives_a_ramp_background_a_gradient_before_fitting()
     assert np.mean((result.scene.render() - ramp) ** 2) < 1e-3
 
 
-def test_small_paths_keep_their_outline_and_fit_their_colour():
+def test_fixed_paths_keep_their_outline_and_fit_their_colour():
     target = scene_of([(square(20, 24, 24), (0.9, 0.2, 0.1, 1.0)), (square(5, 5, 6), (0, 0, 1, 1))])
     start = scene_of(
         [(square(14, 18, 20), (0.5, 0.5, 0.5, 1.0)), (square(5, 5, 6), (0.5, 0.5, 0.5, 1.0))]
     )
-    result = fit_scene(start, target.render(), FitSettings(steps=100, small_path_size=16.0))
+    fixed = replace(start, fixed=np.array([False, True]))
+    result = fit_scene(fixed, target.render(), FitSettings(steps=100))
+    assert list(result.scene.fixed_paths()) == [False, True]
     small = slice(start.offsets[1], start.offsets[2])
     np.testing.assert_array_equal(result.scene.points[small], start.points[small])
     np.testing.assert_allclose(result.scene.colours()[1, :3], (0, 0, 1), atol=0.1)
