@@ -278,7 +278,7 @@ def _finish_pass(
     with _timed(result, "finish"):
         report("finish", 0, 1)
         finished = finish_scene(scene, _finish_settings(config, inputs))
-        scene = _within(finished.scene, config, by_area=True)
+        scene = _within(finished.scene.with_fixed_from(scene), config, by_area=True)
         for name, count in finished.counts.items():
             result.counts[name] = result.counts.get(name, 0) + count
         result.notes.append(_finish_note(finished.counts))

@@ -400,6 +400,16 @@ class Scene:
         """(P,) bool: which paths keep their outline in a fit (`fixed`, all False when None)."""
         return np.zeros(self.path_count, bool) if self.fixed is None else self.fixed
 
+    def with_fixed_from(self, before: Scene) -> Scene:
+        """This scene (``before`` after some edit that rebuilt its paths) with each path fixed
+        that ``before`` had fixed with the very same points: an edit that left a fixed path as
+        it was keeps its flag, one that changed it frees it."""
+        if before.fixed is None:
+            return self
+        kept = {before.path_points(int(i)).tobytes() for i in np.flatnonzero(before.fixed)}
+        flags = [self.path_points(i).tobytes() in kept for i in range(self.path_count)]
+        return replace(self, fixed=np.asarray(flags, dtype=bool))
+
     def with_fixed_outlines(self) -> Scene:
         """This scene with every path's outline fixed (its paint still fitted)."""
         return replace(self, fixed=np.ones(self.path_count, bool))

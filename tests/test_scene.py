@@ -115,3 +115,13 @@ def test_fixed_outlines_follow_their_paths():
     assert stacked.with_paths(list(stacked.paths())).fixed is None
     with pytest.raises(InputError, match="3 paths but 2 fixed flags"):
         replace(stacked, fixed=np.array([True, False]))
+
+
+def test_fixed_flags_survive_an_edit_that_leaves_the_path_as_it_was():
+    red, blue = FlatPaint((1.0, 0.0, 0.0)), FlatPaint((0.0, 0.0, 1.0))
+    before = Scene.from_paths(32, 32, [(square(2, 2, 8), red), (square(12, 12, 8), blue)])
+    before = replace(before, fixed=np.array([True, True]))
+    edited = before.with_paths([(square(12, 12, 8), blue), (square(3, 2, 8), red)])
+    assert edited.fixed is None
+    assert list(edited.with_fixed_from(before).fixed_paths()) == [True, False]
+    assert edited.with_fixed_from(edited).fixed is None

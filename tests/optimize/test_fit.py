@@ -195,6 +195,7 @@ def test_fixed_paths_keep_their_outline_and_fit_their_colour():
     small = slice(start.offsets[1], start.offsets[2])
     np.testing.assert_array_equal(result.scene.points[small], start.points[small])
     np.testing.assert_allclose(result.scene.colours()[1, :3], (0, 0, 1), atol=0.1)
+    np.testing.assert_allclose(result.scene.colours()[0, :3], (0.9, 0.2, 0.1), atol=0.05)
     assert np.abs(result.scene.points[6] - (44, 48)).max() < 1.0  # the large one still moves
     moving = fit_scene(start, target.render(), FitSettings(steps=100)).scene.points[small]
     assert not np.array_equal(moving, start.points[small])
