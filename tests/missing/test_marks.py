@@ -70,29 +70,29 @@ def test_a_misplaced_edge_is_not_a_mark():
     assert groups(target, render) == []
 
 
-def test_stage_four_offers_the_marks_and_paints_them_last():
-    class NoSegmenter:
-        def prompt(self, points: np.ndarray) -> list[list[np.ndarray]]:
-            return [[] for _ in points]
+class NoSegmenter:
+    """SAM's stand-in that finds nothing at any prompt."""
 
+    def prompt(self, points: np.ndarray) -> list[list[np.ndarray]]:
+        return [[] for _ in points]
+
+
+MARKS = MarkSettings()
+
+
+def stage_settings(marks: MarkSettings | None = MARKS) -> MissingSettings:
+    """One round: radius 1, ω 0.5, impact 1e-5, the filter on, regions of 50 pixels or more."""
+    return MissingSettings(1.0, 0.5, 1e-5, True, 50, 1, marks=marks)
+
+
+def test_stage_four_offers_the_marks_and_paints_them_last():
     target = field({spot: LIGHT for spot in DASHES})
-    settings = MissingSettings(
-        radius=1.0,
-        threshold=0.5,
-        impact_threshold=1e-5,
-        filter_by_impact=True,
-        min_pixels=50,
-        rounds=1,
-        marks=MarkSettings(),
-    )
+    settings = stage_settings()
     regions, marks = missing_masks(NoSegmenter(), np.zeros((0, 2)), target, flat_render(), settings)
     assert regions == [] and len(marks) == 1 and ndimage.label(marks[0])[1] == len(DASHES)
     without = missing_masks(
-        NoSegmenter(), np.zeros((0, 2)), target, flat_render(), MissingSettings(
-            radius=1.0, threshold=0.5, impact_threshold=1e-5, filter_by_impact=True,
-            min_pixels=50, rounds=1,
-        )
-    )  # fmt: skip
+        NoSegmenter(), np.zeros((0, 2)), target, flat_render(), stage_settings(marks=None)
+    )
     assert without == ([], [])
 
 
@@ -105,15 +105,7 @@ def test_regions_and_marks_come_apart():
 
     target = field({spot: LIGHT for spot in DASHES})
     target[84:96, 84:96] = DARK
-    settings = MissingSettings(
-        radius=1.0,
-        threshold=0.5,
-        impact_threshold=1e-5,
-        filter_by_impact=True,
-        min_pixels=50,
-        rounds=1,
-        marks=MarkSettings(),
-    )
+    settings = stage_settings()
     prompts = np.array([[90.0, 90.0]])
     regions, marks = missing_masks(SquareSegmenter(), prompts, target, flat_render(), settings)
     assert [int(mask.sum()) for mask in regions] == [144]
@@ -129,20 +121,8 @@ def test_marks_are_traced_closely_and_kept_when_small():
 
 
 def test_a_round_of_stage_four_adds_a_path_for_each_mark():
-    class NoSegmenter:
-        def prompt(self, points: np.ndarray) -> list[list[np.ndarray]]:
-            return [[] for _ in points]
-
     target = field({spot: LIGHT for spot in DASHES})
-    settings = MissingSettings(
-        radius=1.0,
-        threshold=0.5,
-        impact_threshold=1e-5,
-        filter_by_impact=True,
-        min_pixels=50,
-        rounds=1,
-        marks=MarkSettings(),
-    )
+    settings = stage_settings()
     scene = Scene(96, 96, background=GREEN)
     trace = TraceSettings(4, 50, tolerance=2.0)
     done = add_missing(scene, target, NoSegmenter(), settings, trace, FitSettings(steps=0))
