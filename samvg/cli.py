@@ -413,6 +413,46 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
         "until one lowers the error by less than 10%% (0), 1%% (0.5, the default), 0.1%% (1)",
     )
     vectorize.add_argument("--max-paths", type=int, help="at most this many paths")
+    _add_shape_options(vectorize)
+    vectorize.add_argument(
+        "--iterations", type=int, help="optimization steps per phase (default 500, two phases)"
+    )
+    vectorize.add_argument(
+        "--size",
+        type=int,
+        help="working resolution, longest side (default 512); the SVG keeps "
+        "the input's pixel coordinates",
+    )
+    vectorize.add_argument("--seed", type=int, default=0, help="random seed, 0 to 2**32 - 1")
+    vectorize.add_argument("--device", default="cpu", help="cpu (default), cuda, cuda:N or mps")
+    vectorize.add_argument(
+        "--threads",
+        type=int,
+        help="threads for SAM and the rasterizer (default: every core; 1 on a busy machine)",
+    )
+    vectorize.add_argument(
+        "--model",
+        default="mobile_sam",
+        help="SAM variant: mobile_sam (default), vit_b, vit_l, vit_h",
+    )
+    vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
+    vectorize.add_argument("--crops", type=int, help="SAM crop layers (test-time augmentation)")
+    vectorize.add_argument(
+        "--missing-rounds",
+        type=int,
+        help="rounds of stage 4, adding missing parts (default: as --detail decides; paper: 1)",
+    )
+    vectorize.add_argument("--no-lpips", action="store_true", help="optimize MSE + Xing only")
+    vectorize.add_argument("--lpips-weights", help="LPIPS weight file (flat state dict)")
+    vectorize.add_argument(
+        "--no-filter",
+        action="store_true",
+        help="keep every SAM mask (the paper's ablation of filter by impact)",
+    )
+
+
+def _add_shape_options(vectorize: argparse.ArgumentParser) -> None:
+    """The ``vectorize`` options that shape the paths and their fills."""
     vectorize.add_argument(
         "--segments",
         type=int,
@@ -448,41 +488,6 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
         "--no-finish",
         action="store_true",
         help="skip the finish pass (untangling, bounds, hidden paths, merges)",
-    )
-    vectorize.add_argument(
-        "--iterations", type=int, help="optimization steps per phase (default 500, two phases)"
-    )
-    vectorize.add_argument(
-        "--size",
-        type=int,
-        help="working resolution, longest side (default 512); the SVG keeps "
-        "the input's pixel coordinates",
-    )
-    vectorize.add_argument("--seed", type=int, default=0, help="random seed, 0 to 2**32 - 1")
-    vectorize.add_argument("--device", default="cpu", help="cpu (default), cuda, cuda:N or mps")
-    vectorize.add_argument(
-        "--threads",
-        type=int,
-        help="threads for SAM and the rasterizer (default: every core; 1 on a busy machine)",
-    )
-    vectorize.add_argument(
-        "--model",
-        default="mobile_sam",
-        help="SAM variant: mobile_sam (default), vit_b, vit_l, vit_h",
-    )
-    vectorize.add_argument("--checkpoint", help="SAM checkpoint file")
-    vectorize.add_argument("--crops", type=int, help="SAM crop layers (test-time augmentation)")
-    vectorize.add_argument(
-        "--missing-rounds",
-        type=int,
-        help="rounds of stage 4, adding missing parts (default: as --detail decides; paper: 1)",
-    )
-    vectorize.add_argument("--no-lpips", action="store_true", help="optimize MSE + Xing only")
-    vectorize.add_argument("--lpips-weights", help="LPIPS weight file (flat state dict)")
-    vectorize.add_argument(
-        "--no-filter",
-        action="store_true",
-        help="keep every SAM mask (the paper's ablation of filter by impact)",
     )
 
 
