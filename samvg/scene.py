@@ -393,8 +393,7 @@ class Scene:
     def subset(self, keep: Sequence[int] | np.ndarray) -> Scene:
         """Only the paths at indices ``keep`` (in the order given)."""
         kept = self.with_paths([(self.path_points(int(i)), self.paints[int(i)]) for i in keep])
-        indices = np.asarray(keep, dtype=np.int64)
-        return replace(kept, fixed=self.fixed_paths()[indices] if len(indices) else None)
+        return replace(kept, fixed=self.fixed_paths()[np.asarray(keep, dtype=np.int64)])
 
     def fixed_paths(self) -> np.ndarray:
         """(P,) bool: which paths keep their outline in a fit (`fixed`, all False when None)."""

@@ -218,16 +218,17 @@ class _Parameters:
             if variables is not None:
                 point_group.append(variables.geometry)
                 colour_group.append(variables.values)
-        groups: list[tuple[list[torch.Tensor], float | torch.Tensor]] = [
-            (point_group, settings.point_learning_rate),
-            (colour_group, settings.colour_learning_rate),
-        ]
+        point_rate: float | torch.Tensor = settings.point_learning_rate
         if self.scene.fixed is not None:  # fixed outlines: their points' rate is 0
             moving = np.repeat(~self.scene.fixed, np.diff(self.scene.offsets)).astype(np.float32)
-            rate = settings.point_learning_rate * torch.from_numpy(moving)[:, None]
-            groups = [(point_group[1:], settings.point_learning_rate), ([self.points], rate)]
-            groups.append((colour_group, settings.colour_learning_rate))
-        return Adam(groups)
+            point_rate = point_rate * torch.from_numpy(moving)[:, None]
+        return Adam(
+            [
+                ([self.points], point_rate),
+                (point_group[1:], settings.point_learning_rate),
+                (colour_group, settings.colour_learning_rate),
+            ]
+        )
 
     def render(self) -> torch.Tensor:
         scene = self.scene

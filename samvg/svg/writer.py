@@ -23,7 +23,6 @@ from samvg.scene import FlatPaint, LinearGradient, Paint, Scene
 SVG_NAMESPACE = "http://www.w3.org/2000/svg"
 MAX_PRECISION = 10
 """Decimals beyond this only repeat float noise (coordinates are float64 pixels)."""
-"""Decimals beyond this only repeat float noise (coordinates are float64 pixels)."""
 DEFAULT_PRECISION = 1
 """Decimals written unless asked otherwise: a twentieth of a pixel at most, which no render
 shows at the input's size, for about 15 % fewer bytes than two decimals."""
