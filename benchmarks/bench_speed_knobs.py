@@ -2,6 +2,7 @@
 
     python benchmarks/bench_speed_knobs.py fit  base= lp2=lpips_every:2 plat=plateau_steps:50
     python benchmarks/bench_speed_knobs.py pipeline --per-category 4 g32=points_per_side:32 g16=
+    python benchmarks/bench_speed_knobs.py final base= lp2=perceptual_every:2 threads2=threads:2
 
 ``fit``: stage 3 alone. Each of 12 bench images (2 per category) is segmented and traced once
 at the default (no stage 4, no finish pass; cached under ``benchmarks/results/speed_knobs/
@@ -14,26 +15,40 @@ first variant's.
 image under ``benchmarks/results/speed_knobs/pipeline/<variant>/`` (a rerun skips what is there,
 so a long run resumes); ratios against the first variant.
 
+``final``: the default's last whole-scene fit alone (LPIPS, gradient fills), the one fit whose
+knobs leave stage 4's rounds as they are (the rounds draft-fit their new paths without LPIPS).
+Stages 1–4 run once per image at the default and the scene handed to that fit is cached under
+``benchmarks/results/speed_knobs/final_scenes/`` (git ignores it); each variant replaces fields of
+its `FitSettings` (``threads:N`` runs torch on N threads in the fit instead of one) and is scored
+on its render (no finish pass).
+
 A variant is ``name=setting:value,setting:value`` (``name=`` alone: the default). Lines go to
 stdout and to ``benchmarks/results/speed_knobs/<study>.log``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import pickle
 import sys
 import time
+from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
+import torch
 from bench_images import BENCH, REPO, bench_entries, run_samvg, setting_value
 
 import samvg
+import samvg.missing.stage as missing_stage
+import samvg.optimize.fit as fit_module
 from samvg.config import FitOptions
 from samvg.io import atomic_write_text
 from samvg.metrics import load_lpips, lpips_distance
 from samvg.optimize import FitSettings, fit_scene
+from samvg.optimize.losses import lpips_loss
 from samvg.scene import FlatPaint
 
 RESULTS = REPO / "benchmarks/results/speed_knobs"
@@ -70,6 +85,77 @@ def traced_scene(entry: dict[str, str]) -> tuple[samvg.Scene, np.ndarray]:
     with cache.open("wb") as handle:
         pickle.dump((result.scene, result.target), handle)
     return result.scene, result.target
+
+
+def final_scene(entry: dict[str, str]) -> tuple[samvg.Scene, np.ndarray, FitSettings]:
+    """The scene the default pipeline hands its last whole-scene fit, the target and the
+    settings of that fit (cached; the LPIPS loss is bound again on loading)."""
+    cache = RESULTS / "final_scenes" / f"{entry['id']}.pkl"
+    if not cache.exists():
+        calls: list[tuple[samvg.Scene, FitSettings]] = []
+        original = missing_stage.fit_scene
+
+        def recording(scene: samvg.Scene, target: np.ndarray, settings: FitSettings, *rest: Any):
+            if settings.perceptual is not None:
+                calls.append((scene, settings))
+            return original(scene, target, settings, *rest)
+
+        missing_stage.fit_scene = recording
+        try:
+            result = samvg.run(BENCH / entry["png"], samvg.Config())
+        finally:
+            missing_stage.fit_scene = original
+        scene, settings = calls[-1]
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        with cache.open("wb") as handle:
+            pickle.dump((scene, result.target, replace(settings, perceptual=None)), handle)
+    with cache.open("rb") as handle:
+        scene, target, settings = pickle.load(handle)
+    perceptual = lpips_loss(target, FitOptions().lpips_size)
+    return scene, target, replace(settings, perceptual=perceptual)
+
+
+def final_study(chosen: dict[str, dict[str, Any]], log: Log) -> None:
+    lpips = load_lpips()
+    rows: dict[str, list[tuple[float, ...]]] = {name: [] for name in chosen}
+    for entry in bench_entries(2):
+        scene, target, base = final_scene(entry)
+        for name, overrides in chosen.items():
+            changes = dict(overrides)
+            threads = int(changes.pop("threads", 1))
+            settings = replace(base, **changes)
+            started = time.perf_counter()
+            with torch_threads_in_fit(threads):
+                fitted = fit_scene(scene, target, settings).scene
+            seconds = time.perf_counter() - started
+            picture = np.clip(fitted.render(), 0, 1)
+            mse = float(np.mean((picture - target) ** 2))
+            distance = lpips_distance(lpips, picture, target)
+            rows[name].append((mse, distance, seconds))
+            log(f"{entry['id'][:28]:28} {name:10} MSE {mse * 1e3:7.3f}e-3 LPIPS {distance:.4f} "
+                f"{seconds:5.1f} s, {scene.path_count} paths")  # fmt: skip
+    summary(rows, log)
+
+
+@contextlib.contextmanager
+def torch_threads_in_fit(threads: int) -> Iterator[None]:
+    """The fit's torch thread count set to ``threads`` inside the block."""
+    original = fit_module.single_torch_thread
+
+    @contextlib.contextmanager
+    def chosen() -> Iterator[None]:
+        before = torch.get_num_threads()
+        torch.set_num_threads(threads)
+        try:
+            yield
+        finally:
+            torch.set_num_threads(before)
+
+    fit_module.single_torch_thread = chosen
+    try:
+        yield
+    finally:
+        fit_module.single_torch_thread = original
 
 
 def summary(rows: dict[str, list[tuple[float, ...]]], log: Log) -> None:
@@ -147,13 +233,15 @@ def main() -> None:
         at = arguments.index("--per-category")
         per_category = int(arguments[at + 1])
         del arguments[at : at + 2]
-    if len(arguments) < 2 or arguments[0] not in ("fit", "pipeline"):
+    if len(arguments) < 2 or arguments[0] not in ("fit", "pipeline", "final"):
         raise SystemExit(__doc__)
     study, chosen = arguments[0], variants(arguments[1:])
     log = Log(study)
     log(f"# {time.strftime('%Y-%m-%d %H:%M')} {study}: {' '.join(arguments[1:])}")
     if study == "fit":
         fit_study(chosen, log)
+    elif study == "final":
+        final_study(chosen, log)
     else:
         pipeline_study(chosen, log, per_category)
 

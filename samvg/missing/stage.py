@@ -225,8 +225,8 @@ def add_missing_rounds(
     drafted: bool = False,
 ) -> MissingRounds:
     """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
-    less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`). With a ``pool`` (a path
-    budget), rounds take the candidates of largest impact, however small, until the scene has
+    less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`; a round that raises the MSE
+    is rolled back). With a ``pool`` (a path budget), rounds take the candidates of largest impact, however small, until the scene has
     ``pool`` paths or a round finds nothing more (at most ``2 * MAX_AUTO_ROUNDS``). Unless
     ``settings.refit_scene``, rounds fit only the paths they add and the whole scene is fitted
     once at the end (with ``fit_at_end``; else ``fitted`` is False and the caller fits it), also
@@ -254,15 +254,19 @@ def add_missing_rounds(
             done.timings[stage] = done.timings.get(stage, 0.0) + seconds
         if on_round is not None:
             on_round(done.rounds, round_)
-        scene = round_.scene
-        render = scene.render()
-        now = _mse(render, target)
-        gain = (error - now) / max(error, 1e-12)
-        error = now
         if round_.added == 0:
             done.stopped = "no region left that a new path improves"
             break
-        if planned is None and pool is None and gain < settings.gain_tolerance:
+        new_render = round_.scene.render()
+        now = _mse(new_render, target)
+        gain = (error - now) / max(error, 1e-12)
+        automatic = planned is None and pool is None
+        if automatic and gain <= 0:  # the round's paths made the picture worse: they go
+            done.added -= round_.added
+            done.stopped = f"round {done.rounds} would have raised the error: rolled back"
+            break
+        scene, render, error = round_.scene, new_render, now
+        if automatic and gain < settings.gain_tolerance:
             done.stopped = f"round {done.rounds} lowered the error by {gain:.1%}"
             break
     done.fitted = settings.refit_scene or not (done.added or drafted)

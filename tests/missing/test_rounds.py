@@ -72,6 +72,19 @@ def test_a_set_number_of_rounds_runs_exactly_that_many():
     assert done.rounds == 1 and done.added == 3
 
 
+def test_an_automatic_round_that_raises_the_error_is_rolled_back():
+    from dataclasses import replace
+
+    wild = FitSettings(steps=4, point_learning_rate=40.0, colour_learning_rate=1.0)
+    automatic = (replace(settings(), refit_scene=False), STAGES[1], wild)
+    done = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), automatic)
+    assert "rolled back" in done.stopped
+    assert done.added == 0 and done.scene.path_count == 0
+    planned = (replace(settings(rounds=1), refit_scene=False), STAGES[1], wild)
+    kept = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), planned)
+    assert kept.added == 3 and kept.scene.path_count == 3  # a set number of rounds keeps them
+
+
 def test_a_budget_pool_stops_growing_when_full():
     done = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), STAGES, pool=2)
     assert done.scene.path_count == 2 and "pool of 2 paths is full" in done.stopped
