@@ -19,7 +19,7 @@ so a long run resumes); ratios against the first variant.
 knobs leave stage 4's rounds as they are (the rounds draft-fit their new paths without LPIPS).
 Stages 1–4 run once per image at the default and the scene handed to that fit is cached under
 ``benchmarks/results/speed_knobs/final_scenes/`` (git ignores it); each variant replaces fields of
-its `FitSettings` (``threads:N`` runs torch on N threads in the fit instead of one) and is scored
+its `FitSettings` (``threads:N`` runs torch on N threads in the fit) and is scored
 on its render (no finish pass).
 
 A variant is ``name=setting:value,setting:value`` (``name=`` alone: the default). Lines go to
@@ -140,7 +140,7 @@ def final_study(chosen: dict[str, dict[str, Any]], log: Log) -> None:
 @contextlib.contextmanager
 def torch_threads_in_fit(threads: int) -> Iterator[None]:
     """The fit's torch thread count set to ``threads`` inside the block."""
-    original = fit_module.single_torch_thread
+    original = fit_module.fit_torch_threads
 
     @contextlib.contextmanager
     def chosen() -> Iterator[None]:
@@ -151,11 +151,11 @@ def torch_threads_in_fit(threads: int) -> Iterator[None]:
         finally:
             torch.set_num_threads(before)
 
-    fit_module.single_torch_thread = chosen
+    fit_module.fit_torch_threads = chosen
     try:
         yield
     finally:
-        fit_module.single_torch_thread = original
+        fit_module.fit_torch_threads = original
 
 
 def summary(rows: dict[str, list[tuple[float, ...]]], log: Log) -> None:

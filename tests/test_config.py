@@ -101,8 +101,10 @@ def test_rounds_fit_their_new_paths_except_in_the_paper():
 
 
 def test_speed_settings_are_checked_and_the_paper_fits_exactly():
-    assert Config().fit.lpips_every == 1 and Config().fit.coarse_fraction == 0
-    assert Config.paper().fit.lpips_every == 1 and Config.paper().fit.coarse_fraction == 0
+    default, paper = Config().fit, Config.paper().fit
+    assert default.lpips_every == 1 and default.coarse_fraction == 0.5
+    assert default.plateau_steps == 50
+    assert paper.lpips_every == 1 and paper.coarse_fraction == 0 and paper.plateau_steps is None
     for bad in ({"lpips_every": 0}, {"coarse_fraction": 1.5}, {"coarse_fraction": -0.1}):
         with pytest.raises(InputError, match="lpips every|coarse fraction"):
             Config(**bad)
