@@ -134,12 +134,13 @@ class FitResult:
 
 
 @contextlib.contextmanager
-def fit_torch_threads() -> Iterator[None]:
+def fit_torch_threads(perceptual: bool = True) -> Iterator[None]:
     """Run torch inside the block on the rasterizer's thread count (`render_threads`: the run's
-    ``threads``, or every core up to 8), the one thread decision of a fit. Its largest torch
-    work, LPIPS's convolutions, runs about 1.6x faster on two threads than on one."""
+    ``threads``, or every core up to 8) for a fit with LPIPS, whose convolutions run about 1.6x
+    faster on two threads than on one; on one thread without it (the per-step tensors of MSE
+    and Xing are small: a thread pool costs more than it saves)."""
     threads = torch.get_num_threads()
-    torch.set_num_threads(render_threads())
+    torch.set_num_threads(render_threads() if perceptual else 1)
     try:
         yield
     finally:
@@ -362,7 +363,7 @@ def _fit_level(
     if settings.steps > 0 and parameters.learns:
         optimizer = parameters.optimizer(settings)
         objective = _Objective(target, settings, segment_indices(scene.offsets))
-        with fit_torch_threads():
+        with fit_torch_threads(settings.perceptual is not None):
             for step in range(settings.steps):
                 optimizer.zero_grad()
                 loss, reported = objective(parameters.render(), parameters.points, step)
