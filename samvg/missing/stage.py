@@ -226,8 +226,9 @@ def add_missing_rounds(
 ) -> MissingRounds:
     """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
     less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`; a round that raises the MSE
-    is rolled back). With a ``pool`` (a path budget), rounds take the candidates of largest impact, however small, until the scene has
-    ``pool`` paths or a round finds nothing more (at most ``2 * MAX_AUTO_ROUNDS``). Unless
+    is rolled back). With a ``pool`` (a path budget), rounds take the candidates of largest
+    impact, however small, until the scene has ``pool`` paths or a round finds nothing more (at
+    most ``2 * MAX_AUTO_ROUNDS``). Unless
     ``settings.refit_scene``, rounds fit only the paths they add and the whole scene is fitted
     once at the end (with ``fit_at_end``; else ``fitted`` is False and the caller fits it), also
     when no round added a path to a ``drafted`` scene (one given a draft fit only)."""
