@@ -143,7 +143,7 @@ def torch_threads_in_fit(threads: int) -> Iterator[None]:
     original = fit_module.fit_torch_threads
 
     @contextlib.contextmanager
-    def chosen(_perceptual: bool = True) -> Iterator[None]:
+    def chosen(_perceptual: bool) -> Iterator[None]:
         before = torch.get_num_threads()
         torch.set_num_threads(threads)
         try:

@@ -228,10 +228,10 @@ def add_missing_rounds(
     less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`; a round that raises the MSE
     is rolled back). With a ``pool`` (a path budget), rounds take the candidates of largest
     impact, however small, until the scene has ``pool`` paths or a round finds nothing more (at
-    most ``2 * MAX_AUTO_ROUNDS``). Unless
-    ``settings.refit_scene``, rounds fit only the paths they add and the whole scene is fitted
-    once at the end (with ``fit_at_end``; else ``fitted`` is False and the caller fits it), also
-    when no round added a path to a ``drafted`` scene (one given a draft fit only)."""
+    most ``2 * MAX_AUTO_ROUNDS``). Unless ``settings.refit_scene``, rounds fit only the paths
+    they add and the whole scene is fitted once at the end (with ``fit_at_end``; else ``fitted``
+    is False and the caller fits it), also when no round added a path to a ``drafted`` scene (one
+    given a draft fit only)."""
     settings, trace, fit = stages
     full_at = None
     if pool is not None:
@@ -239,6 +239,7 @@ def add_missing_rounds(
         settings = replace(settings, impact_threshold=0.0, max_paths=full_at)
     planned = settings.rounds
     most = planned if planned is not None else MAX_AUTO_ROUNDS * (2 if pool else 1)
+    automatic = planned is None and pool is None  # rounds until the gain falls off
     done = MissingRounds(scene)
     render = scene.render()
     error = _mse(render, target)
@@ -261,7 +262,6 @@ def add_missing_rounds(
         new_render = round_.scene.render()
         now = _mse(new_render, target)
         gain = (error - now) / max(error, 1e-12)
-        automatic = planned is None and pool is None
         if automatic and gain <= 0:  # the round's paths made the picture worse: they go
             done.added -= round_.added
             done.stopped = f"round {done.rounds} would have raised the error: rolled back"

@@ -134,7 +134,7 @@ class FitResult:
 
 
 @contextlib.contextmanager
-def fit_torch_threads(perceptual: bool = True) -> Iterator[None]:
+def fit_torch_threads(perceptual: bool) -> Iterator[None]:
     """Run torch inside the block on the rasterizer's thread count (`render_threads`: the run's
     ``threads``, or every core up to 8) for a fit with LPIPS, whose convolutions run about 1.6x
     faster on two threads than on one; on one thread without it (the per-step tensors of MSE
