@@ -143,9 +143,9 @@ def torch_threads_in_fit(threads: int) -> Iterator[None]:
     original = fit_module.fit_torch_threads
 
     @contextlib.contextmanager
-    def chosen(_perceptual: bool) -> Iterator[None]:
+    def chosen(perceptual: bool) -> Iterator[None]:
         before = torch.get_num_threads()
-        torch.set_num_threads(threads)
+        torch.set_num_threads(threads if perceptual else 1)
         try:
             yield
         finally:

@@ -156,10 +156,14 @@ class FitOptions:
     lpips_every: int = 1
     """Evaluate LPIPS every this many steps; the steps between reuse its last gradient with
     respect to the render (1: every step, the paper and the default)."""
-    coarse_fraction: float = 0.5
+    coarse_fraction: float = 0.6
     """The share of each phase's steps fitted first at half size, coarse to fine (0: none, the
-    paper). Half, by default: the last whole-scene fit is about 25 % faster at the same MSE and
-    LPIPS (``benchmarks/results/speed_knobs/final.log``)."""
+    paper)."""
+    coarse_lpips: bool = False
+    """Whether the half-size steps include LPIPS. Off by default: LPIPS costs as much per step
+    at half size as at full size, and with 60 % of the steps at half size on MSE + Xing only the
+    last whole-scene fit took 0.66x the time of half the steps at half size with LPIPS, at MSE
+    x0.95 and LPIPS x1.01 (``benchmarks/results/speed_knobs/final.log``)."""
     plateau_steps: int | None = 50
     """Stop a phase (each size of it) early once its loss improved by less than 0.1 % over this
     many steps (None: every phase runs all its steps, the paper). Draft fits run all theirs."""

@@ -7,6 +7,7 @@ import pytest
 
 from samvg import Config, InputError
 from samvg.config import FitOptions, MissingOptions, SegmentOptions, TraceOptions
+from samvg.optimize import FitSettings
 
 
 def test_settings_by_name_land_in_their_stage_group():
@@ -102,8 +103,9 @@ def test_rounds_fit_their_new_paths_except_in_the_paper():
 
 def test_speed_settings_are_checked_and_the_paper_fits_exactly():
     default, paper = Config().fit, Config.paper().fit
-    assert default.lpips_every == 1 and default.coarse_fraction == 0.5
-    assert default.plateau_steps == 50
+    assert default.lpips_every == 1 and default.coarse_fraction == 0.6
+    assert default.plateau_steps == 50 and not default.coarse_lpips
+    assert FitSettings.from_options(default).coarse_perceptual is False
     assert paper.lpips_every == 1 and paper.coarse_fraction == 0 and paper.plateau_steps is None
     for bad in ({"lpips_every": 0}, {"coarse_fraction": 1.5}, {"coarse_fraction": -0.1}):
         with pytest.raises(InputError, match="lpips every|coarse fraction"):

@@ -58,6 +58,9 @@ class FitSettings:
     """Evaluate LPIPS every this many steps and reuse its gradient in between (1: every step)."""
     coarse_fraction: float = 0.0
     """The share of the steps fitted first at half size (0: all at full size)."""
+    coarse_perceptual: bool = True
+    """Whether the half-size steps include the perceptual term (False: MSE + Xing there, LPIPS
+    only at full size, where it costs the same per step but matters)."""
     plateau_steps: int | None = None
     """Stop a phase (each size of it) once its loss has stopped improving over this many steps
     (None: always run every step)."""
@@ -97,6 +100,7 @@ class FitSettings:
             bounds=bounds,
             perceptual_every=options.lpips_every,
             coarse_fraction=options.coarse_fraction,
+            coarse_perceptual=options.coarse_lpips,
             plateau_steps=options.plateau_steps,
             gradient_cost=options.gradient_cost if options.gradients else None,
             draft_steps=min(options.draft_iterations, options.iterations),
@@ -321,7 +325,7 @@ def fit_scene(
         small = _fit_level(
             small_scene,
             _check_target(halve(target_tensor.numpy()), small_scene),
-            replace(settings, steps=coarse, bounds=_halved(settings.bounds)),
+            _coarse_settings(settings, coarse),
             on_step,
             underlay=None if underlay is None else halve(underlay),
         )
@@ -337,6 +341,14 @@ def _coarse_steps(scene: Scene, settings: FitSettings) -> int:
     if max(scene.width, scene.height) < COARSE_MIN_SIDE or scene.path_count == 0:
         return 0
     return int(round(settings.steps * settings.coarse_fraction))
+
+
+def _coarse_settings(settings: FitSettings, steps: int) -> FitSettings:
+    """The half-size level's settings: ``steps`` steps, bounds halved, LPIPS as asked."""
+    coarse = replace(settings, steps=steps, bounds=_halved(settings.bounds))
+    if not settings.coarse_perceptual:
+        coarse = replace(coarse, perceptual=None, perceptual_weight=0.0)
+    return coarse
 
 
 def _halved(

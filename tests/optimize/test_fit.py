@@ -4,6 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+import torch
 
 from samvg import InputError, SamvgError
 from samvg.optimize import FitSettings, fit_scene
@@ -123,6 +124,30 @@ def test_coarse_to_fine_fit_lands_on_the_full_canvas():
     small = fit_scene(scene_of([(square(1, 1, 4), (0, 0, 0, 1))], size=16), np.ones((16, 16, 3)),
                       FitSettings(steps=4, coarse_fraction=0.5))  # fmt: skip
     assert len(small.losses) == 4  # too small to halve: all steps at full size
+
+
+def test_the_coarse_level_leaves_lpips_out_when_asked():
+    size = 160
+    target = scene_of([(square(60, 64, 60), (0.9, 0.2, 0.1, 1.0))], size=size).render()
+    start = scene_of([(square(40, 50, 50), (0.5, 0.5, 0.5, 1.0))], size=size)
+    sizes: list[tuple[int, ...]] = []
+
+    def perceptual(rendered: torch.Tensor) -> torch.Tensor:
+        sizes.append(tuple(rendered.shape))
+        return rendered.mean()
+
+    for coarse_perceptual, expected in ((True, 60), (False, 24)):
+        sizes.clear()
+        settings = FitSettings(
+            steps=60,
+            coarse_fraction=0.6,
+            perceptual=perceptual,
+            perceptual_weight=0.01,
+            coarse_perceptual=coarse_perceptual,
+        )
+        result = fit_scene(start, target, settings)
+        assert len(result.losses) == 60 and len(sizes) == expected
+        assert (size, size, 3) in sizes and ((80, 80, 3) in sizes) == coarse_perceptual
 
 
 def test_a_fit_stops_once_its_loss_stops_improving():
