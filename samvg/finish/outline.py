@@ -6,8 +6,12 @@ computes exactly that: it nodes the polygon's edges (``shapely.node``), builds t
 (``shapely.polygonize``), keeps those whose interior point has a nonzero winding number and
 unions them. (``shapely.make_valid`` and ``buffer(0)`` read a crossing ring by the even-odd rule
 or drop lobes; they would turn a path's curl, painted twice by the renderer, into a hole.)
-``outline_parts`` turns such an area back into the exterior rings of its parts, largest first,
-holes filled (a single closed path cannot carry one; the tracer fills them too).
+``outline_parts`` turns such an area back into the exterior rings of its parts, largest first.
+A single closed path cannot carry a hole, and filling one would paint over whatever the hole
+showed (a crossing path that loops round the paths beneath it), so a part with a hole of
+`HOLE_AREA` px² or more is cut across each such hole, by a vertical line through it, into
+pieces without holes; the pieces overlap by `CUT_OVERLAP` px along each cut so that no seam of
+what lies beneath shows between them. Smaller holes are filled.
 """
 
 from __future__ import annotations
@@ -18,6 +22,12 @@ from shapely.geometry.base import BaseGeometry
 
 #: Area (px²) under which an outline part paints nothing worth a path.
 DEGENERATE_AREA = 0.25
+#: Holes of at least this area (px²) are cut round rather than filled (`outline_parts`).
+HOLE_AREA = 4.0
+#: How far (px) each piece of a part cut at a hole reaches over the cut.
+CUT_OVERLAP = 0.5
+#: At most this many cuts per part; holes left after them are filled.
+MAX_CUTS = 64
 
 
 def _ring_array(vertices: np.ndarray, vertex_offsets: np.ndarray) -> np.ndarray:
@@ -99,11 +109,13 @@ def _polygons_in(geometry: BaseGeometry) -> list[BaseGeometry]:
 def outline_parts(
     geometry: BaseGeometry, min_area: float, canvas: BaseGeometry | None = None
 ) -> list[np.ndarray]:
-    """Exterior rings (N, 2), not closed, of the polygons of ``geometry``, holes filled, by
-    decreasing area on the ``canvas`` (if given; parts off it paint nothing): the largest
-    unless it is degenerate (< ``DEGENERATE_AREA``), then every other part of at least
-    ``min_area`` px²."""
-    shells = np.array([shapely.Polygon(part.exterior) for part in _polygons_in(geometry)])
+    """Exterior rings (N, 2), not closed, of the polygons of ``geometry``, cut round their
+    large holes (`hole_free_pieces`), small holes filled, by decreasing area on the ``canvas``
+    (if given; parts off it paint nothing): the largest unless it is degenerate
+    (< ``DEGENERATE_AREA``), then every other part of at least ``min_area`` px²."""
+    shells = np.array(
+        [piece for part in _polygons_in(geometry) for piece in hole_free_pieces(part)]
+    )
     if len(shells) == 0:
         return []
     areas = shapely.area(shells if canvas is None else shapely.intersection(shells, canvas))
@@ -115,9 +127,45 @@ def outline_parts(
 
 
 def filled_holes(geometry: BaseGeometry) -> int:
-    """How many holes of at least ``DEGENERATE_AREA`` px² ``outline_parts`` fills."""
+    """How many holes of ``DEGENERATE_AREA`` to `HOLE_AREA` px² ``outline_parts`` fills (larger
+    ones are cut round)."""
     holes = [shapely.Polygon(ring) for part in _polygons_in(geometry) for ring in part.interiors]
-    return sum(1 for hole in holes if hole.area >= DEGENERATE_AREA)
+    return sum(1 for hole in holes if DEGENERATE_AREA <= hole.area < HOLE_AREA)
+
+
+def hole_free_pieces(polygon: shapely.Polygon, cuts: int = MAX_CUTS) -> list[shapely.Polygon]:
+    """``polygon`` as polygons without holes that paint the same area together: cut across its
+    largest hole of `HOLE_AREA` px² or more (along the hole's shorter side, through the middle
+    of its bounds), each side reaching `CUT_OVERLAP` px over the cut, then each side the same
+    way. Smaller holes, and any left after ``cuts`` cuts, are filled."""
+    large = [shapely.Polygon(ring) for ring in polygon.interiors]
+    large = [hole for hole in large if hole.area >= HOLE_AREA]
+    if not large or cuts <= 0:
+        return [shapely.Polygon(polygon.exterior)]
+    hole = max(large, key=lambda candidate: candidate.area)
+    pieces = [part for side in _sides(polygon, hole) for part in _polygons_in(side)]
+    inside = hole.point_on_surface()
+    if any(shapely.Polygon(ring).contains(inside) for piece in pieces for ring in piece.interiors):
+        return [shapely.Polygon(polygon.exterior)]  # the cut missed the hole
+    budget = (cuts - 1) // max(1, len(pieces))
+    return [whole for piece in pieces for whole in hole_free_pieces(piece, budget)]
+
+
+def _sides(polygon: shapely.Polygon, hole: shapely.Polygon) -> list[BaseGeometry]:
+    """``polygon`` on either side of a line across ``hole``'s middle (vertical when the hole is
+    wider than tall), each side overlapping the line by `CUT_OVERLAP`."""
+    left, bottom, right, top = (float(value) for value in polygon.bounds)
+    x0, y0, x1, y1 = (float(value) for value in hole.bounds)
+    left, bottom, right, top = left - 1.0, bottom - 1.0, right + 1.0, top + 1.0
+    if x1 - x0 >= y1 - y0:
+        cut = (x0 + x1) / 2
+        first = shapely.box(left, bottom, cut + CUT_OVERLAP, top)
+        second = shapely.box(cut - CUT_OVERLAP, bottom, right, top)
+    else:
+        cut = (y0 + y1) / 2
+        first = shapely.box(left, bottom, right, cut + CUT_OVERLAP)
+        second = shapely.box(left, cut - CUT_OVERLAP, right, top)
+    return [polygon.intersection(first), polygon.intersection(second)]
 
 
 def path_regions(vertices: np.ndarray, vertex_offsets: np.ndarray) -> np.ndarray:

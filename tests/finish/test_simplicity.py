@@ -77,18 +77,23 @@ def test_a_collapsed_path_is_dropped():
     assert repaired.paints[0].rgba == BLUE
 
 
-def test_a_hole_a_path_loops_round_is_filled_and_counted():
+def test_a_hole_a_path_loops_round_is_cut_round_not_painted_over():
     # Round an ellipse one way, across to a smaller one, round it the other way and back: the
-    # two crossings cancel, and the inner ellipse is a hole (winding number 0).
+    # two crossings cancel, and the inner ellipse is a hole (winding number 0) that shows the
+    # blue path beneath.
     outer = cubics_of(ellipse(256, 256, 150, 100))
-    inner = cubics_of(ellipse(256, 256, 60, 40))[::-1, ::-1]
-    across = straight_path(np.array([[406.0, 256.0], [316.0, 256.0]]))
-    there = np.append(across[:3], [[316.0, 256.0]], axis=0)
+    inner = cubics_of(ellipse(256.5, 256, 60, 40))[::-1, ::-1]  # cut at x = 256.5, mid-pixel
+    across = straight_path(np.array([[406.0, 256.0], [316.5, 256.0]]))
+    there = np.append(across[:3], [[316.5, 256.0]], axis=0)
     back = np.append(across[3:], [[406.0, 256.0]], axis=0)
     ring = path_of(np.concatenate([outer, there[None], inner, back[None]]))
-    scene = scene_of((ring, RED))
+    scene = scene_of((ellipse(256, 256, 70, 50), BLUE), (ring, RED))
     region = fill_region(flatten_path(ring))
     assert len(region.interiors) == 1
     repaired, counts = simplify_paths(scene)
-    assert counts["simple_repaired"] == 1 and counts["simple_holes_filled"] == 1
-    assert repaired.path_count == 1 and is_simple(repaired.path_points(0))
+    assert counts["simple_repaired"] == 1 and counts["simple_holes_filled"] == 0
+    assert repaired.path_count >= 3 and len(crossing_paths(repaired)) == 0
+    before, after = scene.render(), repaired.render()
+    assert np.allclose(after[256, 256], BLUE[:3], atol=1e-3)  # the hole still shows blue
+    assert np.allclose(after[180, 256], RED[:3], atol=1e-3)  # no seam where the cut runs
+    assert np.abs(after - before).mean() < 1e-3
