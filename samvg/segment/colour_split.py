@@ -2,15 +2,13 @@
 a suit symbol on a card) gets one part per extra colour, to be painted on top of it, so that no
 path is filled with the blur of two colours.
 
-The colours are found by k-means in CIELAB on a sample of the mask's pixels (SciPy's
-``kmeans2``, k-means++ seeding, the best of two starts: a third of the time of scikit-learn's
-``KMeans`` per call on these few thousand points, and a photo makes hundreds of calls); k grows
-while each step still removes a large share of the colour variance and the centres stay distinct
-(``contrast``, in ΔE). The mask keeps its most common colour; each connected region of another
-colour (opened with a 3 × 3 square, so that the one- or two-pixel anti-aliased seams between
-colours do not become parts of their own) becomes a part with its holes filled. A filled part can
-again hold other colours (a ring's inside), so parts are split the same way, ``depth`` levels
-deep.
+The colours are found by k-means in CIELAB (scikit-learn ``KMeans``) on a sample of the mask's
+pixels; k grows while each step still removes a large share of the colour variance and the
+centres stay distinct (``contrast``, in ΔE). The mask keeps its most common colour; each
+connected region of another colour (opened with a 3 × 3 square, so that the one- or two-pixel
+anti-aliased seams between colours do not become parts of their own) becomes a part with its
+holes filled. A filled part can again hold other colours (a ring's inside), so parts are split
+the same way, ``depth`` levels deep.
 """
 
 from __future__ import annotations
@@ -19,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
-from scipy.cluster.vq import ClusterError, kmeans2
 from skimage.color import rgb2lab
+from sklearn.cluster import KMeans
 
 from samvg.imaging import filled_components
 
@@ -28,8 +26,6 @@ from samvg.imaging import filled_components
 SAMPLE_PIXELS = 4000
 #: k grows while the next centre removes at least this share of the remaining colour variance.
 MIN_VARIANCE_DROP = 0.4
-#: k-means starts per k (the lowest inertia is kept).
-KMEANS_STARTS = 2
 _OPENING = np.ones((3, 3), dtype=bool)
 
 
@@ -64,36 +60,15 @@ def colour_clusters(pixels: np.ndarray, settings: ColourSplitSettings) -> np.nda
     best: np.ndarray | None = None
     inertia = spread * len(sample)
     distinct = len(np.unique(np.round(sample, 1), axis=0))
-    sample = sample.astype(np.float64)
     for k in range(2, min(settings.max_colours, distinct) + 1):
-        found = k_means(sample, k, rng)
-        if found is None:
-            break
-        centres, labels, k_inertia = found
+        kmeans = KMeans(n_clusters=k, n_init=2, random_state=settings.seed).fit(sample)
+        centres = kmeans.cluster_centers_
         gaps = np.linalg.norm(centres[:, None] - centres[None], axis=2)
         closest = gaps[~np.eye(k, dtype=bool)].min()
-        if closest < settings.contrast or k_inertia > (1 - MIN_VARIANCE_DROP) * inertia:
+        if closest < settings.contrast or kmeans.inertia_ > (1 - MIN_VARIANCE_DROP) * inertia:
             break
-        counts = np.bincount(labels, minlength=k)
-        best, inertia = centres[np.argsort(-counts, kind="stable")], k_inertia
-    return best
-
-
-def k_means(
-    points: np.ndarray, k: int, rng: np.random.Generator
-) -> tuple[np.ndarray, np.ndarray, float] | None:
-    """The best of `KMEANS_STARTS` k-means runs on ``points`` (n, d): centres (k, d), labels
-    (n,) and inertia (sum of squared distances to the centres), or None when every run left a
-    cluster empty."""
-    best: tuple[np.ndarray, np.ndarray, float] | None = None
-    for _ in range(KMEANS_STARTS):
-        try:
-            centres, labels = kmeans2(points, k, minit="++", missing="raise", rng=rng)
-        except ClusterError:
-            continue
-        inertia = float(((points - centres[labels]) ** 2).sum())
-        if best is None or inertia < best[2]:
-            best = (centres, labels, inertia)
+        counts = np.bincount(kmeans.labels_, minlength=k)
+        best, inertia = centres[np.argsort(-counts, kind="stable")], kmeans.inertia_
     return best
 
 
