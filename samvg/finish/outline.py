@@ -9,9 +9,9 @@ or drop lobes; they would turn a path's curl, painted twice by the renderer, int
 ``outline_parts`` turns such an area back into the exterior rings of its parts, largest first.
 A single closed path cannot carry a hole, and filling one would paint over whatever the hole
 showed (a crossing path that loops round the paths beneath it), so a part with a hole of
-`HOLE_AREA` px² or more is cut across each such hole, by a vertical line through it, into
-pieces without holes; the pieces overlap by `CUT_OVERLAP` px along each cut so that no seam of
-what lies beneath shows between them. Smaller holes are filled.
+`HOLE_AREA` px² or more is cut across each such hole, by a line through its middle along its
+shorter side, into pieces without holes; the pieces overlap by `CUT_OVERLAP` px along each cut
+so that no seam of what lies beneath shows between them. Smaller holes are filled.
 """
 
 from __future__ import annotations
@@ -138,8 +138,8 @@ def hole_free_pieces(polygon: shapely.Polygon, cuts: int = MAX_CUTS) -> list[sha
     largest hole of `HOLE_AREA` px² or more (along the hole's shorter side, through the middle
     of its bounds), each side reaching `CUT_OVERLAP` px over the cut, then each side the same
     way. Smaller holes, and any left after ``cuts`` cuts, are filled."""
-    large = [shapely.Polygon(ring) for ring in polygon.interiors]
-    large = [hole for hole in large if hole.area >= HOLE_AREA]
+    holes = [shapely.Polygon(ring) for ring in polygon.interiors]
+    large = [hole for hole in holes if hole.area >= HOLE_AREA]
     if not large or cuts <= 0:
         return [shapely.Polygon(polygon.exterior)]
     hole = max(large, key=lambda candidate: candidate.area)
