@@ -105,20 +105,49 @@ def _cluster_parts(
     top, left = rows.min(), cols.min()
     window = np.full((rows.max() - top + 1, cols.max() - left + 1), -1, dtype=np.int16)
     window[rows - top, cols - left] = nearest
-    parts: list[np.ndarray] = []
+    parts: list[_Region] = []
     for cluster in range(0 if with_main else 1, len(centres)):
         region = ndimage.binary_opening(window == cluster, _OPENING)
         for part in filled_components(region, settings.min_pixels):
             full = np.zeros(mask.shape, dtype=bool)
             full[top : top + part.shape[0], left : left + part.shape[1]] = part
             for found in (full, *_cluster_parts(full, lab, settings, depth - 1, False)):
-                if not any(_same_region(found, other) for other in parts):
-                    parts.append(found)
-    return parts
+                candidate = _Region.of(found)
+                if not any(candidate.same_as(other) for other in parts):
+                    parts.append(candidate)
+    return [part.mask for part in parts]
 
 
-def _same_region(first: np.ndarray, second: np.ndarray, overlap: float = 0.9) -> bool:
-    """Whether two masks cover nearly the same pixels (a disc found inside a ring's filled part
-    and again as a region of its own colour)."""
-    shared = np.count_nonzero(first & second)
-    return bool(shared >= overlap * max(np.count_nonzero(first), np.count_nonzero(second)))
+@dataclass(frozen=True)
+class _Region:
+    """A full-size mask with its pixel count and bounds, so that comparing two stays cheap."""
+
+    mask: np.ndarray
+    count: int
+    rows: tuple[int, int]
+    cols: tuple[int, int]
+
+    @classmethod
+    def of(cls, mask: np.ndarray) -> _Region:
+        rows = np.flatnonzero(mask.any(axis=1))
+        cols = np.flatnonzero(mask.any(axis=0))
+        if len(rows) == 0:
+            return cls(mask, 0, (0, 0), (0, 0))
+        count = int(np.count_nonzero(mask))
+        bounds = (int(rows[0]), int(rows[-1]) + 1), (int(cols[0]), int(cols[-1]) + 1)
+        return cls(mask, count, *bounds)
+
+    def same_as(self, other: _Region, overlap: float = 0.9) -> bool:
+        """Whether the two masks cover nearly the same pixels (a disc found inside a ring's
+        filled part and again as a region of its own colour): at least ``overlap`` of the
+        larger one's pixels shared."""
+        larger = max(self.count, other.count)
+        if min(self.count, other.count) < overlap * larger:
+            return False
+        top, bottom = max(self.rows[0], other.rows[0]), min(self.rows[1], other.rows[1])
+        left, right = max(self.cols[0], other.cols[0]), min(self.cols[1], other.cols[1])
+        if top >= bottom or left >= right:
+            return larger == 0
+        window = (slice(top, bottom), slice(left, right))
+        shared = np.count_nonzero(self.mask[window] & other.mask[window])
+        return bool(shared >= overlap * larger)
