@@ -20,6 +20,7 @@ class Segmenter:
             self.model,
             points_per_side=options.points_per_side,
             crop_n_layers=options.crop_n_layers,
+            skip_covered=options.skip_covered_points,
         )
         self.predictor = SamPredictor(self.model)
         self._image: np.ndarray | None = None
