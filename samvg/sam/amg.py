@@ -96,6 +96,8 @@ class SamAutomaticMaskGenerator:
         self.mask_batch = max(1, int(mask_batch))
         self.skip_covered = skip_covered
         self.timings: dict[str, float] = {}
+        self.prompted = 0
+        """How many grid points the last `generate` ran through the decoder."""
         self.image_embedding: torch.Tensor | None = None
         """The whole image's embedding from the last `generate` (reuse it to prompt again)."""
 
@@ -109,6 +111,7 @@ class SamAutomaticMaskGenerator:
         img = to_rgb_uint8(image, min_side=2)
         self.timings = {"encoder": 0.0, "decoder": 0.0, "masks": 0.0, "post": 0.0}
         self.image_embedding = None
+        self.prompted = 0
         orig_size = (img.shape[0], img.shape[1])
         crop_boxes, layer_idxs = generate_crop_boxes(
             orig_size, self.crop_n_layers, self.crop_overlap_ratio
@@ -178,6 +181,7 @@ class SamAutomaticMaskGenerator:
                 if len(batch) == 0:
                     continue
             pts = torch.as_tensor(batch, dtype=torch.float32)
+            self.prompted += len(pts)
             tp = pred.transform_coords(pts)[:, None, :]
             sparse, _ = self.model.prompt_encoder((tp, torch.ones(len(pts), 1)), None, None)
             st = fd.transformer(sparse)

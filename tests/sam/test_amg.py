@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import torch
+from PIL import Image
 
 from samvg.sam import SamAutomaticMaskGenerator
+from samvg.sam.amg import coarse_first
 from samvg.sam.amg_utils import (
     batched_mask_to_box,
     box_iou,
@@ -69,6 +71,28 @@ def test_amg_crop_layers_and_small_regions(sam_model, photo):
         seg = a["segmentation"]
         _, changed = remove_small_regions(seg, 30, "islands")
         assert not changed
+
+
+def test_skipping_covered_points_prompts_fewer_and_finds_the_same_parts(sam_model, bench_dir):
+    image = Image.open(bench_dir / "emoji" / "fluentflat_crab.png").convert("RGB")
+    crab = np.asarray(image.resize((256, 256), Image.BILINEAR)).copy()
+    every = SamAutomaticMaskGenerator(sam_model, points_per_side=16)
+    skipping = SamAutomaticMaskGenerator(sam_model, points_per_side=16, skip_covered=True)
+    full = [a["segmentation"] for a in every.generate(crab)]
+    found = [a["segmentation"] for a in skipping.generate(crab)]
+    assert every.prompted == 256 and skipping.prompted <= 128
+    _check_annotations(skipping.generate(crab), 256, 256)
+    union, union_found = np.any(full, axis=0), np.any(found, axis=0)
+    assert (union & union_found).sum() >= 0.98 * union.sum()
+    for mask in full:
+        best = max((mask & other).sum() / (mask | other).sum() for other in found)
+        assert best >= 0.75, "every part the whole grid finds is found again"
+
+
+def test_coarse_first_visits_every_other_row_and_column_first():
+    order = coarse_first(build_point_grid(4))
+    assert order[:4].tolist() == [0, 2, 8, 10]
+    assert sorted(order.tolist()) == list(range(16))
 
 
 def test_grid_and_crops_match_upstream_conventions():
