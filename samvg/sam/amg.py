@@ -27,8 +27,10 @@ from samvg.sam.image import to_rgb_uint8
 from samvg.sam.model import Sam
 from samvg.sam.predictor import SamPredictor, needed_lowres, resize_logits
 
-#: RGB distance (0-255) within which a grid point has the colour of the mask that covers it.
-COVERED_COLOUR_TOLERANCE = 24.0
+#: RGB distance (0-255) within which a grid point has the colour of the mask that covers it
+#: (24 in the 24-image run of `benchmarks/results/speed.md`; 12 kept all of debian_emerald's
+#: paths in a check of four of the images that lost quality, and changed nothing on the others).
+COVERED_COLOUR_TOLERANCE = 12.0
 
 
 class SamAutomaticMaskGenerator:
