@@ -188,11 +188,7 @@ class SamAutomaticMaskGenerator:
             sparse, _ = self.model.prompt_encoder((tp, torch.ones(len(pts), 1)), None, None)
             st = fd.transformer(sparse)
             iou = st.iou[:, mask_ids]
-            ok = (
-                iou > self.pred_iou_thresh
-                if self.pred_iou_thresh > 0
-                else torch.ones_like(iou, dtype=torch.bool)
-            )
+            ok = (iou > self.pred_iou_thresh) | (self.pred_iou_thresh <= 0)
             prompt_idx = torch.nonzero(ok.any(1)).flatten()
             self.timings["decoder"] += time.perf_counter() - t0
             t0 = time.perf_counter()
@@ -227,19 +223,23 @@ class SamAutomaticMaskGenerator:
                 collected.append(part)
             self.timings["masks"] += time.perf_counter() - t0
         t0 = time.perf_counter()
-        data = _cat(collected, (ch, cw))
-        keep = nms(data["boxes"].float(), data["iou"], self.box_nms_thresh)
-        data = _filter(data, keep)
-        data["boxes"] = uncrop_boxes_xyxy(data["boxes"], crop_box)
-        data["points"] = uncrop_points(data["points"], crop_box)
-        data["masks"] = uncrop_masks(data["masks"], crop_box, orig_h, orig_w)
-        data["crop_boxes"] = torch.tensor([crop_box] * len(data["iou"]), dtype=torch.long).view(
-            -1, 4
-        )
+        data = self._crop_result(_cat(collected, (ch, cw)), crop_box, orig_size)
         if crop_box == [0, 0, orig_w, orig_h]:
             self.image_embedding = pred.get_image_embedding()
         pred.reset_image()
         self.timings["post"] += time.perf_counter() - t0
+        return data
+
+    def _crop_result(
+        self, data: dict[str, torch.Tensor], crop_box: list[int], orig_size: tuple[int, int]
+    ) -> dict[str, torch.Tensor]:
+        """One crop's masks after NMS, moved from the crop into the whole image."""
+        data = _filter(data, nms(data["boxes"].float(), data["iou"], self.box_nms_thresh))
+        data["boxes"] = uncrop_boxes_xyxy(data["boxes"], crop_box)
+        data["points"] = uncrop_points(data["points"], crop_box)
+        data["masks"] = uncrop_masks(data["masks"], crop_box, *orig_size)
+        boxes = torch.tensor([crop_box] * len(data["iou"]), dtype=torch.long)
+        data["crop_boxes"] = boxes.view(-1, 4)
         return data
 
     @staticmethod
