@@ -287,7 +287,7 @@ class _Coverage:
         cols = torch.as_tensor(np.clip(points[:, 0].astype(np.int64), 0, width - 1))
         rows = torch.as_tensor(np.clip(points[:, 1].astype(np.int64), 0, height - 1))
         owners = self.owner[rows, cols]
-        if not self.colours or bool((owners < 0).all()):
+        if bool((owners < 0).all()):
             return np.zeros(len(points), dtype=bool)
         means = torch.stack(self.colours)[owners.clamp(min=0)]
         near = torch.linalg.vector_norm(self.image[rows, cols] - means, dim=1) <= self.tolerance

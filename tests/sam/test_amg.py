@@ -79,9 +79,10 @@ def test_skipping_covered_points_prompts_fewer_and_finds_the_same_parts(sam_mode
     every = SamAutomaticMaskGenerator(sam_model, points_per_side=16)
     skipping = SamAutomaticMaskGenerator(sam_model, points_per_side=16, skip_covered=True)
     full = [a["segmentation"] for a in every.generate(crab)]
-    found = [a["segmentation"] for a in skipping.generate(crab)]
+    annotations = skipping.generate(crab)
+    found = [a["segmentation"] for a in annotations]
     assert every.prompted == 256 and skipping.prompted <= 128
-    _check_annotations(skipping.generate(crab), 256, 256)
+    _check_annotations(annotations, 256, 256)
     union, union_found = np.any(full, axis=0), np.any(found, axis=0)
     assert (union & union_found).sum() >= 0.98 * union.sum()
     for mask in full:
