@@ -16,8 +16,8 @@ report gives medians and the median of the per-image ratios. Every run is one JS
 and LPIPS are measured by the working tree's code on both SVGs, rendered at the 512-px working
 size. The report goes to ``benchmarks/results/speed.md``, with a plot of time against path
 count (``speed_paths.png``) for samvg, random init (diffvg) and the LIVE-style baseline at fixed
-budgets, drawn from the records of ``bench_detail.py budget --records
-benchmarks/results/speed/paths`` (which time every run).
+budgets, drawn from the records of ``bench_detail.py budget`` (which time every run) in
+``--paths-records`` (default ``benchmarks/results/speed/paths``).
 """
 
 from __future__ import annotations
@@ -183,7 +183,9 @@ def _quality_rows(old: dict, new: dict, keys: list, preset: str) -> list[str]:
     return rows
 
 
-def write_report(old_label: str, records: Path = RECORDS, new_label: str | None = None) -> None:
+def write_report(
+    old_label: str, records: Path = RECORDS, new_label: str | None = None, paths: Path = PATHS
+) -> None:
     old, new = _records(f"old-{old_label}", records), _records("new", records)
     if not any(key in new for key in old):
         raise SystemExit(f"no paired records under {records} for {old_label}: run `run` first")
@@ -218,25 +220,27 @@ def write_report(old_label: str, records: Path = RECORDS, new_label: str | None 
         if keys:
             lines += _stage_rows(old, new, keys, preset)
             quality += _quality_rows(old, new, keys, preset)
-    REPORT.write_text("\n".join(lines + quality + _paths_section()) + "\n")
+    REPORT.write_text("\n".join(lines + quality + _paths_section(paths)) + "\n")
     print(REPORT.read_text())
 
 
-def _budget_seconds() -> dict[str, dict[int, list[float]]]:
-    """Seconds of the budget runs of ``bench_detail.py budget --records
-    benchmarks/results/speed/paths``, by method and path budget."""
+def _budget_seconds(folder: Path) -> tuple[dict[str, dict[int, list[float]]], set[str]]:
+    """Seconds of the budget runs of ``bench_detail.py budget --records <folder>``, by method
+    and path budget, and the categories of the images they ran on."""
     seconds: dict[str, dict[int, list[float]]] = {}
-    for path in sorted(PATHS.glob("*.json")):
+    categories: set[str] = set()
+    for path in sorted(folder.glob("*.json")):
         record = json.loads(path.read_text())
         if record.get("study") == "budget" and record["method"] in PLOTTED:
             by_budget = seconds.setdefault(record["method"], {})
             by_budget.setdefault(int(record["budget"]), []).append(float(record["seconds"]))
-    return seconds
+            categories.add(record["category"])
+    return seconds, categories
 
 
-def _paths_section() -> list[str]:
+def _paths_section(folder: Path) -> list[str]:
     """The time-against-paths table and plot (medians over the images run at each budget)."""
-    seconds = _budget_seconds()
+    seconds, categories = _budget_seconds(folder)
     if not seconds:
         return []
     import matplotlib
@@ -244,14 +248,15 @@ def _paths_section() -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    shown = folder.resolve().relative_to(REPO) if folder.resolve().is_relative_to(REPO) else folder
     lines = [
         "",
         "## Time against path count (median seconds per image)",
         "",
-        "`python benchmarks/bench_detail.py budget --records benchmarks/results/speed/paths "
-        "--per-category 1 --categories emoji,photo --paths 16,64,256 --methods "
-        "samvg-gradients,diffvg,live` (samvg-gradients is the default, gradient fills on; random "
-        "init and the LIVE-style baseline: 1000 steps with samvg's losses).",
+        f"The runs of `python benchmarks/bench_detail.py budget --records {shown}` on "
+        f"{', '.join(sorted(categories))} images (samvg-gradients is the default, gradient "
+        "fills on; random init (diffvg) and the LIVE-style baseline: 1000 steps with samvg's "
+        "losses). Each record times its own run.",
         "",
         "| method | paths | images | median s |",
         "|---|---|---|---|",
@@ -284,6 +289,12 @@ def main() -> None:
     parser.add_argument("--keep-svg", type=Path, help="also write every run's SVG to this folder")
     parser.add_argument("--new", help="the commit to measure (default: the working tree)")
     parser.add_argument("--records", type=Path, default=RECORDS, help="the records' folder")
+    parser.add_argument(
+        "--paths-records",
+        type=Path,
+        default=PATHS,
+        help="the folder of bench_detail.py budget records to plot time against paths from",
+    )
     arguments = parser.parse_args()
     records = arguments.records.resolve()
     if arguments.study == "run":
@@ -292,7 +303,7 @@ def main() -> None:
             arguments.old, arguments.per_category, presets, arguments.keep_svg, arguments.new,
             records,
         )  # fmt: skip
-    write_report(arguments.old, records, arguments.new)
+    write_report(arguments.old, records, arguments.new, arguments.paths_records)
 
 
 if __name__ == "__main__":
