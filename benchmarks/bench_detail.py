@@ -1,12 +1,13 @@
 """Detail at any path budget (issue 11): samvg at N paths against VTracer tuned to N paths, the
 LIVE-style baseline and random init (diffvg) at N, and samvg with gradient fills at N (issue
-13); a rate-distortion sweep for photos and paintings (flat and with gradients); and the report,
-which also holds the default against VTracer's default settings (from the records of
-``bench_geometry.py --settings default``).
+13); VTracer's settings swept on photos and paintings for the rate-distortion plot (beside samvg
+at the budgets of the budget study); and the report, which also holds the default against
+VTracer's default settings (from the records of ``bench_geometry.py --settings default``).
 
-    python benchmarks/bench_detail.py budget --per-category 4 --paths 16,64
+    python benchmarks/bench_detail.py budget --per-category 4 --paths 16,64,256 \
+        --methods samvg-gradients,vtracer,live,diffvg --records benchmarks/results/detail/budget-X
     python benchmarks/bench_detail.py rate --per-category 4
-    python benchmarks/bench_detail.py report
+    python benchmarks/bench_detail.py report --records benchmarks/results/detail/budget-X
 
 Every run is one JSON record in ``benchmarks/results/detail/`` (a rerun skips what is there, so
 a long run resumes); the report goes to ``benchmarks/results/detail.md`` and the
@@ -146,26 +147,15 @@ def run_budget(
                     save(records, name, entry, extra, baseline_record, method, budget, lpips)
 
 
-def run_rate(
-    entries: list[dict[str, str]],
-    budgets: list[int],
-    overrides: dict[str, Any],
-    keep_svg: Path | None = None,
-) -> None:
+def run_rate(entries: list[dict[str, str]]) -> None:
+    """VTracer at every setting of `VTRACER_SWEEP` (samvg's points of the rate-distortion plot
+    are its runs at each budget of the ``budget`` study)."""
     lpips = load_lpips()
     for entry in entries:
         for setting in VTRACER_SWEEP:
             tag = "-".join(map(str, setting))
             extra = {"study": "rate", "method": "vtracer", "setting": tag}
             save(RECORDS, f"rate.vtracer.{tag}", entry, extra, vtracer_record, setting, lpips)
-        for budget in budgets:
-            for method in ("samvg", "samvg-gradients"):
-                extra = {"study": "rate", "method": method, "setting": str(budget)}
-                extra["overrides"] = overrides
-                gradients = method == "samvg-gradients"
-                config = samvg.Config(paths=budget, gradients=gradients, **overrides)
-                name = f"rate.{method}.{budget}"
-                save(RECORDS, name, entry, extra, samvg_record, config, lpips, keep_svg)
 
 
 def main() -> None:
@@ -214,7 +204,7 @@ def main() -> None:
         methods = arguments.methods.split(",")
         run_budget(entries, budgets, methods, overrides, arguments.keep_svg, arguments.records)
     else:
-        run_rate(entries, budgets, overrides, arguments.keep_svg)
+        run_rate(entries)
 
 
 def _setting(text: str) -> tuple[str, Any]:

@@ -83,7 +83,7 @@ def budget_tables(records: list[dict[str, Any]], folder: Path) -> list[str]:
     (lower MSE and lower LPIPS on the same image). samvg is its default (gradient fills) where
     those records exist, else flat fills."""
     rows = [r for r in records if r.get("study") == "budget"]
-    subject = "samvg-gradients" if any(r["method"] == "samvg-gradients" for r in rows) else "samvg"
+    subject = _subject(rows)
     by_key: dict[tuple[int, str], dict[str, dict[str, Any]]] = defaultdict(dict)
     for row in rows:
         by_key[(row["budget"], row["id"])][row["method"]] = row
@@ -100,6 +100,7 @@ def budget_tables(records: list[dict[str, Any]], folder: Path) -> list[str]:
         "method's record; *wins* = images where samvg has lower MSE **and** lower LPIPS than "
         "that method (the goal: ≥ 90 % in every category).",
     ]
+    lines += _wins_summary(by_key, subject)
     for budget in sorted({b for b, _ in by_key}):
         complete = {i: m for (b, i), m in by_key.items() if b == budget and subject in m}
         methods = sorted({name for m in complete.values() for name in m} - {"samvg", subject})
@@ -117,6 +118,36 @@ def budget_tables(records: list[dict[str, Any]], folder: Path) -> list[str]:
         for category in (*CATEGORIES, "all"):
             for method in [subject, *methods]:
                 lines += _budget_row(category, by_category.get(category, []), subject, method)
+    return lines
+
+
+def _wins_summary(
+    by_key: dict[tuple[int, str], dict[str, dict[str, Any]]], subject: str
+) -> list[str]:
+    """One table of samvg's wins: a row per category, a column per budget and baseline."""
+    columns = sorted(
+        {(b, name) for (b, _), found in by_key.items() if subject in found for name in found}
+        - {(b, name) for b, _ in by_key for name in ("samvg", subject)}
+    )
+    header = " | ".join(f"N={b} vs {name}" for b, name in columns)
+    lines = ["", "samvg's wins, per category and budget:", ""]
+    lines += [f"| category | {header} |", "|---|" + "---:|" * len(columns)]
+    for category in (*CATEGORIES, "all"):
+        cells = []
+        for budget, method in columns:
+            pairs = [
+                found
+                for (b, _), found in by_key.items()
+                if b == budget and subject in found and method in found
+                and category in ("all", found[subject]["category"])
+            ]  # fmt: skip
+            won = sum(
+                m[subject]["mse"] < m[method]["mse"] and m[subject]["lpips"] < m[method]["lpips"]
+                for m in pairs
+            )
+            cells.append(f"{won}/{len(pairs)}" if pairs else "")
+        if any(cells):
+            lines.append(f"| {category} | " + " | ".join(cells) + " |")
     return lines
 
 
@@ -213,37 +244,57 @@ def _settings_note(rows: list[dict[str, Any]]) -> str:
     )
 
 
-def rate_plot(records: list[dict[str, Any]]) -> list[str]:
-    """Mean MSE and LPIPS against mean SVG bytes for photos and paintings, per setting."""
+def rate_plot(records: list[dict[str, Any]], budget_records: list[dict[str, Any]]) -> list[str]:
+    """Mean MSE and LPIPS against mean SVG bytes for photos and paintings: samvg at each
+    budget of the equal-budget study, VTracer at each setting of its sweep (``bench_detail.py
+    rate``), over the images that have every point."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    rows = [r for r in records if r.get("study") == "rate"]
-    if not rows:
+    curves: dict[str, dict[str, dict[str, dict[str, Any]]]] = defaultdict(lambda: defaultdict(dict))
+    for row in records:
+        if row.get("study") == "rate" and row["method"] == "vtracer":
+            curves["vtracer (settings)"][row["setting"]][row["id"]] = row
+    budget_rows = [r for r in budget_records if r.get("study") == "budget"]
+    subject = _subject(budget_rows)
+    for row in budget_rows:
+        if row["method"] == subject and row["category"] in ("photo", "painting"):
+            curves[f"{subject} (--paths N)"][str(row["budget"])][row["id"]] = row
+    if len(curves) < 2:
         return []
-    curves: dict[str, dict[str, list[dict[str, Any]]]] = defaultdict(lambda: defaultdict(list))
-    for row in rows:
-        curves[row["method"]][row["setting"]].append(row)
+    common = set.intersection(*(set(g) for s in curves.values() for g in s.values()))
+    if not common:
+        return []
     figure, axes = plt.subplots(1, 2, figsize=(10, 4))
-    lines = ["", "## Rate-distortion, photos and paintings", ""]
-    samvg_rows = [r for r in rows if r["method"] != "vtracer"]
-    if samvg_rows:
-        lines += ["samvg at `--paths N`. " + _settings_note(samvg_rows), ""]
-    lines += [f"![rate]({PLOT.name})", ""]
-    lines += [
-        "| method | setting | images | bytes | MSE ×1e-3 | LPIPS |",
-        "|---|---|---:|---:|---:|---:|",
+    lines = [
+        "",
+        "## Rate-distortion, photos and paintings",
+        "",
+        f"{len(common)} images: samvg at each budget of the equal-budget study above (default "
+        "settings), VTracer at five settings (filter_speckle, color_precision, layer_difference; "
+        "`python benchmarks/bench_detail.py rate --per-category 4`, 4-6-16 is its default). "
+        "Means over the same images at every point; lower is better on both axes.",
+        "",
+        f"![rate]({PLOT.name})",
+        "",
+        "| method | setting | images | paths | bytes | MSE ×1e-3 | LPIPS |",
+        "|---|---|---:|---:|---:|---:|---:|",
     ]
     for method, settings in sorted(curves.items()):
-        points = sorted(
-            (_mean(g, "svg_bytes"), _mean(g, "mse"), _mean(g, "lpips"), s, len(g))
-            for s, g in settings.items()
-        )
-        for size, mse, lpips, setting, count in points:
+        points = []
+        for setting, by_id in settings.items():
+            group = [by_id[i] for i in sorted(common)]
+            points.append(
+                (_mean(group, "svg_bytes"), _mean(group, "mse"), _mean(group, "lpips"), setting,
+                 _mean(group, "paths"))
+            )  # fmt: skip
+        points.sort()
+        for size, mse, lpips, setting, paths in points:
             lines.append(
-                f"| {method} | {setting} | {count} | {size:.0f} | {1e3 * mse:.2f} | {lpips:.3f} |"
+                f"| {method} | {setting} | {len(common)} | {paths:.0f} | {size:.0f} | "
+                f"{1e3 * mse:.2f} | {lpips:.3f} |"
             )
         sizes = [p[0] for p in points]
         axes[0].plot(sizes, [p[1] for p in points], "o-", label=method)
@@ -258,13 +309,20 @@ def rate_plot(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+def _subject(rows: list[dict[str, Any]]) -> str:
+    """samvg's method in budget records: its default (gradient fills) where those records
+    exist, else flat fills."""
+    return "samvg-gradients" if any(r["method"] == "samvg-gradients" for r in rows) else "samvg"
+
+
 def write_report(
     records_folder: Path, geometry: list[Path], budget_folder: Path | None = None
 ) -> None:
     """detail.md from the records: the default against VTracer (a table per folder of
     ``geometry``), the equal-budget
     tables (``budget_folder``, else the budget records of ``records_folder``), the gradient
-    table and the rate-distortion plot (``records_folder``)."""
+    table (``records_folder``) and the rate-distortion plot (samvg from the budget records,
+    VTracer's sweep from ``records_folder``)."""
     records = _records(records_folder, "*.json")
     budget_folder = budget_folder or records_folder
     budget_records = _records(budget_folder, "*.json")
@@ -278,7 +336,7 @@ def write_report(
         "",
         *budget_tables(budget_records, budget_folder),
         *gradient_table(records),
-        *rate_plot(records),
+        *rate_plot(records, budget_records),
     ]
     atomic_write_text(REPORT, "\n".join(lines) + "\n")
     print(f"wrote {REPORT}")
