@@ -63,16 +63,26 @@ def geometry_checks(scene: Scene, opaque_input: bool) -> dict[str, Any]:
 
 
 def run_one(
-    entry: dict[str, str], config: samvg.Config, lpips: Any, with_vtracer: bool = False
+    entry: dict[str, str],
+    config: samvg.Config,
+    lpips: Any,
+    with_vtracer: bool = False,
+    keep_svg: Path | None = None,
 ) -> dict[str, Any]:
+    """One image's record; with ``keep_svg``, samvg's SVG is also written there as
+    ``<id>.svg`` (for a contact sheet without reruns)."""
     run = run_samvg(entry, config)
     render = run.render()
-    written = samvg.VectorImage.from_svg(run.result.image.to_svg())  # what the SVG file holds
+    svg_text = run.result.image.to_svg()
+    if keep_svg is not None:
+        keep_svg.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(keep_svg / f"{entry['id']}.svg", svg_text)
+    written = samvg.VectorImage.from_svg(svg_text)  # what the SVG file holds
     record = geometry_checks(written.scene, opaque_input=True)
     record.update(
         id=entry["id"],
         category=entry["category"],
-        svg_bytes=len(run.result.image.to_svg().encode()),
+        svg_bytes=len(svg_text.encode()),
         mse=float(np.mean((render - run.target) ** 2)),
         lpips=lpips_distance(lpips, render, run.target),
         seconds=run.seconds,
@@ -97,7 +107,9 @@ def configs(name: str, paths: int | None) -> samvg.Config:
     raise SystemExit(f"unknown setting {name!r}")
 
 
-def run_all(entries: list[dict[str, str]], out: Path, names: list[str]) -> None:
+def run_all(
+    entries: list[dict[str, str]], out: Path, names: list[str], keep_svg: Path | None = None
+) -> None:
     out.mkdir(parents=True, exist_ok=True)
     lpips = load_lpips()
     for entry in entries:
@@ -111,7 +123,9 @@ def run_all(entries: list[dict[str, str]], out: Path, names: list[str]) -> None:
                 if not reference.exists():
                     continue
                 paths = json.loads(reference.read_text())["paths"]
-            record = run_one(entry, configs(name, paths), lpips, with_vtracer=name == "default")
+            config = configs(name, paths)
+            kept = keep_svg / name if keep_svg is not None else None
+            record = run_one(entry, config, lpips, with_vtracer=name == "default", keep_svg=kept)
             record["setting"] = name
             atomic_write_text(record_file, json.dumps(record, indent=1))
             print(json.dumps(record), flush=True)
@@ -221,13 +235,16 @@ def main() -> None:
     parser.add_argument(
         "--shard", default="0/1", help="i/n: run only every n-th image from the i-th (workers)"
     )
+    parser.add_argument(
+        "--keep-svg", type=Path, help="also write samvg's SVGs to <this folder>/<setting>/"
+    )
     arguments = parser.parse_args()
     names = arguments.settings.split(",")
     shard, shards = (int(part) for part in arguments.shard.split("/"))
     if not arguments.report_only:
         categories = arguments.categories.split(",") if arguments.categories else None
         entries = bench_entries(arguments.per_category, categories)[shard::shards]
-        run_all(entries, arguments.out, names)
+        run_all(entries, arguments.out, names, arguments.keep_svg)
     write_report(arguments.out, names, arguments.report)
 
 

@@ -7,7 +7,9 @@ N paths], one row per bench image, with path counts, MSE and SVG bytes under eac
     python benchmarks/contact_sheet.py --ids gnome_field_l,noto_cactus --preset default -o f.png
 
 ``--svg-dir`` draws SVGs written earlier (``bench_detail.py --keep-svg``) instead of running
-samvg: one column per ``<id>.<tag>.svg`` file of the image, in name order, then VTracer's.
+samvg: one column per ``<id>.<tag>.svg`` file of the image, in name order, with VTracer's after
+the first (name them ``<id>.1-default.svg``, ``<id>.2-64.svg`` for target | samvg default |
+VTracer default | samvg at 64 paths).
 
 Photos and paintings may be drawn for a local look (``--categories photo,painting``), but their
 sheets must not be committed (the bench's licences forbid copies of them in the repository).
@@ -85,7 +87,8 @@ def row_for(
 
 
 def row_from_svgs(entry: dict[str, str], folder: Path) -> list[Image.Image]:
-    """Target | every saved SVG of the image | VTracer's default, with paths, MSE and bytes."""
+    """Target | the image's first saved SVG | VTracer's default | its other saved SVGs, with
+    paths, MSE and bytes."""
     from samvg import VectorImage
 
     working, scale = working_image(entry)
@@ -103,8 +106,8 @@ def row_from_svgs(entry: dict[str, str], folder: Path) -> list[Image.Image]:
     svg = vtracer_default(working)
     theirs = render_svg(svg, width, height)
     error = float(np.mean((theirs - target) ** 2))
-    row.append(cell(theirs, f"vtracer {svg.count('<path')}p {error * 1e3:.2f}e-3 "
-                            f"{len(svg) / 1e3:.0f}kB"))  # fmt: skip
+    row.insert(2, cell(theirs, f"vtracer {svg.count('<path')}p {error * 1e3:.2f}e-3 "
+                               f"{len(svg) / 1e3:.0f}kB"))  # fmt: skip
     return row
 
 
