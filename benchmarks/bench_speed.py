@@ -3,6 +3,7 @@ older commit against the working tree, run alternately image by image on one mac
 
     python benchmarks/bench_speed.py run --old 45a9978 --per-category 4
     python benchmarks/bench_speed.py report --old 45a9978
+    python benchmarks/bench_speed.py paths --paths-records benchmarks/results/detail/budget-X
 
 ``--new REV`` measures a commit instead of the working tree (so the tree can change while it
 runs), and ``--records DIR`` keeps a run's records apart from an earlier one's (another
@@ -39,6 +40,7 @@ REPORT = REPO / "benchmarks/results/speed.md"
 PLOT = REPO / "benchmarks/results/speed_paths.png"
 PATHS = REPO / "benchmarks/results/speed/paths"
 PLOTTED = ("samvg", "samvg-gradients", "diffvg", "live")
+PATHS_HEADING = "## Time against path count (median seconds per image)"
 PRESETS = ("default", "fast")
 STAGES = ("segment", "trace", "optimize", "reshape", "missing", "refine", "reduce", "finish")
 
@@ -224,17 +226,19 @@ def write_report(
     print(REPORT.read_text())
 
 
-def _budget_seconds(folder: Path) -> tuple[dict[str, dict[int, list[float]]], set[str]]:
+def _budget_seconds(
+    folder: Path,
+) -> tuple[dict[str, dict[int, list[float]]], dict[str, str]]:
     """Seconds of the budget runs of ``bench_detail.py budget --records <folder>``, by method
-    and path budget, and the categories of the images they ran on."""
+    and path budget, and the category of each image they ran on."""
     seconds: dict[str, dict[int, list[float]]] = {}
-    categories: set[str] = set()
+    categories: dict[str, str] = {}
     for path in sorted(folder.glob("*.json")):
         record = json.loads(path.read_text())
         if record.get("study") == "budget" and record["method"] in PLOTTED:
             by_budget = seconds.setdefault(record["method"], {})
             by_budget.setdefault(int(record["budget"]), []).append(float(record["seconds"]))
-            categories.add(record["category"])
+            categories[record["id"]] = record["category"]
     return seconds, categories
 
 
@@ -251,11 +255,11 @@ def _paths_section(folder: Path) -> list[str]:
     shown = folder.resolve().relative_to(REPO) if folder.resolve().is_relative_to(REPO) else folder
     lines = [
         "",
-        "## Time against path count (median seconds per image)",
+        PATHS_HEADING,
         "",
         f"The runs of `python benchmarks/bench_detail.py budget --records {shown}` on "
-        f"{', '.join(sorted(categories))} images (samvg-gradients is the default, gradient "
-        "fills on; random init (diffvg) and the LIVE-style baseline: 1000 steps with samvg's "
+        f"{len(categories)} images ({', '.join(sorted(set(categories.values())))}; "
+        "samvg-gradients is the default, gradient fills on; random init (diffvg) and the LIVE-style baseline: 1000 steps with samvg's "
         "losses). Each record times its own run.",
         "",
         "| method | paths | images | median s |",
@@ -277,13 +281,25 @@ def _paths_section(folder: Path) -> list[str]:
     return [*lines, "", f"![time against paths]({PLOT.name})"]
 
 
+def replace_paths_section(paths: Path) -> None:
+    """Redraw only the time-against-paths section of ``speed.md`` (and its plot), keeping the
+    rest of the report as it stands."""
+    text = REPORT.read_text() if REPORT.exists() else ""
+    kept = text.split(PATHS_HEADING)[0].rstrip("\n")
+    section = _paths_section(paths)
+    if not section:
+        raise SystemExit(f"no budget records of {', '.join(PLOTTED)} under {paths}")
+    REPORT.write_text("\n".join([kept, *section]) + "\n")
+    print(f"wrote {REPORT} and {PLOT}")
+
+
 def main() -> None:
     if len(sys.argv) > 1 and sys.argv[1] == "worker":
         worker(sys.argv[2], sys.argv[3])
         return
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("study", choices=("run", "report"))
-    parser.add_argument("--old", required=True, help="the commit to compare with")
+    parser.add_argument("study", choices=("run", "report", "paths"))
+    parser.add_argument("--old", help="the commit to compare with (run, report)")
     parser.add_argument("--per-category", type=int, default=4)
     parser.add_argument("--presets", default="default,fast")
     parser.add_argument("--keep-svg", type=Path, help="also write every run's SVG to this folder")
@@ -296,6 +312,11 @@ def main() -> None:
         help="the folder of bench_detail.py budget records to plot time against paths from",
     )
     arguments = parser.parse_args()
+    if arguments.study == "paths":
+        replace_paths_section(arguments.paths_records)
+        return
+    if arguments.old is None:
+        parser.error(f"{arguments.study} needs --old")
     records = arguments.records.resolve()
     if arguments.study == "run":
         presets = arguments.presets.split(",")
