@@ -259,8 +259,8 @@ def _paths_section(folder: Path) -> list[str]:
         "",
         f"The runs of `python benchmarks/bench_detail.py budget --records {shown}` on "
         f"{len(categories)} images ({', '.join(sorted(set(categories.values())))}; "
-        "samvg-gradients is the default, gradient fills on; random init (diffvg) and the LIVE-style baseline: 1000 steps with samvg's "
-        "losses). Each record times its own run.",
+        "samvg-gradients is the default, gradient fills on; random init (diffvg) and the "
+        "LIVE-style baseline: 1000 steps with samvg's losses). Each record times its own run.",
         "",
         "| method | paths | images | median s |",
         "|---|---|---|---|",
