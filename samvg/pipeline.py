@@ -456,7 +456,9 @@ def _finish_note(counts: dict[str, int]) -> str:
         f"{counts.get('bounds_clipped', 0)} clipped to the canvas, "
         f"{counts.get('hidden_removed', 0)} hidden paths removed, "
         f"{counts.get('merged', 0)} merged"
-    )
+        + (", the path over the whole canvas made the background"
+           if counts.get("background_from_path") else "")
+    )  # fmt: skip
 
 
 def simple_when_saved(scene: Scene, precision: int = DEFAULT_PRECISION) -> Scene:

@@ -1,16 +1,17 @@
 """The finish stage: clean, editable geometry before saving (see ``finish``).
 
 Bounded control points (``bounds``), simple paths (``simplicity``), no hidden paths
-(``hidden``), merged paths of near-equal colour (``merge``) and an optional palette
-(``palette``). They share one flattener (``flatten``), the painted area of a path as shapely
-geometry (``outline``), outlines redrawn from the cubics they were cut from (``trim``) or fitted
-afresh (``refit``), cubic-segment operations (``cubics``) and per-path scene edits (``edits``).
+(``hidden``, which also turns a path over the whole canvas into the background), merged paths
+of near-equal colour (``merge``) and an optional palette (``palette``). They share one
+flattener (``flatten``), the painted area of a path as shapely geometry (``outline``),
+outlines redrawn from the cubics they were cut from (``trim``) or fitted afresh (``refit``),
+cubic-segment operations (``cubics``) and per-path scene edits (``edits``).
 """
 
 from samvg.finish.bounds import bound_paths, default_margin, margin_box
 from samvg.finish.finish import FinishResult, FinishSettings, finish_scene
 from samvg.finish.flatten import flatten_path, flatten_paths
-from samvg.finish.hidden import remove_hidden
+from samvg.finish.hidden import background_from_cover, remove_hidden
 from samvg.finish.merge import merge_paths
 from samvg.finish.palette import snap_colours
 from samvg.finish.refit import refit_ring
@@ -19,6 +20,7 @@ from samvg.finish.trim import redraw_ring
 
 __all__ = [
     "FinishResult",
+    "background_from_cover",
     "FinishSettings",
     "bound_paths",
     "crossing_paths",

@@ -1,9 +1,10 @@
 """The finish stage: the last pass over a scene before it is saved.
 
 ``finish_scene`` runs, in order: bounded geometry (``bounds``), simple paths (``simplicity``),
-hidden paths (``hidden``), merging (``merge``) and the palette (``palette``), each switchable in
-:class:`FinishSettings` (bounds always runs), and gathers their counts. Every path a step
-redraws keeps its control points inside the canvas plus the margin.
+hidden paths and a path that hides the background (``hidden``), merging (``merge``) and the
+palette (``palette``), each switchable in :class:`FinishSettings` (bounds always runs), and
+gathers their counts. Every path a step redraws keeps its control points inside the canvas plus
+the margin.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy as np
 
 from samvg.errors import InputError
 from samvg.finish.bounds import bound_paths, default_margin, margin_box
-from samvg.finish.hidden import HIDDEN_TOLERANCE, remove_hidden
+from samvg.finish.hidden import HIDDEN_TOLERANCE, background_from_cover, remove_hidden
 from samvg.finish.merge import merge_paths
 from samvg.finish.palette import check_colour_count, snap_colours
 from samvg.finish.simplicity import MIN_PART_AREA, simplify_paths
@@ -101,6 +102,8 @@ def finish_scene(scene: Scene, settings: FinishSettings | None = None) -> Finish
         counts.update(step)
     if settings.remove_hidden:
         scene, step = remove_hidden(scene, settings.hidden_tolerance)
+        counts.update(step)
+        scene, step = background_from_cover(scene, settings.hidden_tolerance)
         counts.update(step)
     if settings.merge:
         scene, step = merge_paths(scene, settings.merge_delta_e, tolerance, box)
