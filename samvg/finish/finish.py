@@ -39,15 +39,17 @@ class FinishSettings:
     ``margin``: how far (px) control points may lie outside the canvas; None: 2 % of the longer
     side. ``tolerance``: largest distance (px) of an outline fitted afresh from the area it
     redraws (outlines cut from existing paths keep those paths' cubics and need no fit).
-    ``merge_delta_e``: largest CIELAB ΔE of two fills that merge. ``colours``: snap the fills to
-    this many colours (None: keep them). ``min_part_area``: smallest part (px²) split off a
-    crossing or clipped path kept as its own path. ``hidden_tolerance``: uncovered area (px²) a
-    hidden path may keep.
+    ``background_from_path``: an opaque lowest path over the whole canvas becomes the background
+    (with ``remove_hidden``). ``merge_delta_e``: largest CIELAB ΔE of two fills that merge.
+    ``colours``: snap the fills to this many colours (None: keep them). ``min_part_area``:
+    smallest part (px²) split off a crossing or clipped path kept as its own path.
+    ``hidden_tolerance``: uncovered area (px²) a hidden path may keep.
     """
 
     simplify: bool = True
     margin: float | None = None
     remove_hidden: bool = True
+    background_from_path: bool = True
     merge: bool = True
     merge_delta_e: float = 2.0
     colours: int | None = None
@@ -56,7 +58,7 @@ class FinishSettings:
     hidden_tolerance: float = HIDDEN_TOLERANCE
 
     def __post_init__(self) -> None:
-        for name in ("simplify", "remove_hidden", "merge"):
+        for name in ("simplify", "remove_hidden", "background_from_path", "merge"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} must be True or False, got {getattr(self, name)!r}")
         if self.margin is not None:
@@ -103,8 +105,9 @@ def finish_scene(scene: Scene, settings: FinishSettings | None = None) -> Finish
     if settings.remove_hidden:
         scene, step = remove_hidden(scene, settings.hidden_tolerance)
         counts.update(step)
-        scene, step = background_from_cover(scene, settings.hidden_tolerance)
-        counts.update(step)
+        if settings.background_from_path:
+            scene, step = background_from_cover(scene, settings.hidden_tolerance)
+            counts.update(step)
     if settings.merge:
         scene, step = merge_paths(scene, settings.merge_delta_e, tolerance, box)
         counts.update(step)

@@ -2,7 +2,7 @@
 covers below do not hide it. An opaque lowest path over the whole canvas becomes the
 background."""
 
-from samvg.finish import background_from_cover, finish_scene, remove_hidden
+from samvg.finish import FinishSettings, background_from_cover, finish_scene, remove_hidden
 from samvg.scene import FlatPaint, RadialGradient, Scene
 from tests.finish.shapes import BLUE, RED, ellipse, mean_abs_diff, scene_of, square
 
@@ -84,3 +84,10 @@ def test_the_finish_pass_removes_what_the_surround_hides_and_makes_it_the_backgr
     assert finished.counts["background_from_path"] == 1
     assert finished.scene.path_count == 1 and finished.scene.background == RED[:3]
     assert mean_abs_diff(scene, finished.scene) < 1e-3
+
+
+def test_the_finish_pass_can_leave_the_surround_a_path():
+    scene = scene_of((square(-4, -4, 520), RED), (ellipse(300, 300, 40, 30), BLUE))
+    finished = finish_scene(scene, FinishSettings(background_from_path=False))
+    assert "background_from_path" not in finished.counts
+    assert finished.scene.path_count == 2
