@@ -28,6 +28,10 @@ MAX_AUTO_ROUNDS = 6
 #: A path budget's pool: stage 4 grows the scene to this many times the budget before the
 #: paths of least impact are removed.
 BUDGET_POOL = 1.25
+#: Under a budget, a round that finds nothing halves stage 4's error bars (the prompts' ω, the
+#: wrong pixels' and the marks' error) and tries again, at most this many times: the budget is
+#: filled from the largest errors left, as LIVE fills it, before the scene is declared done.
+BUDGET_EASINGS = 3
 
 
 @dataclass(frozen=True)
@@ -227,11 +231,11 @@ def add_missing_rounds(
     """Stage 4 repeated: ``settings.rounds`` rounds, or with None until a round lowers the MSE by
     less than ``settings.gain_tolerance`` (at most `MAX_AUTO_ROUNDS`; a round that raises the MSE
     is rolled back). With a ``pool`` (a path budget), rounds take the candidates of largest
-    impact, however small, until the scene has ``pool`` paths or a round finds nothing more (at
-    most ``2 * MAX_AUTO_ROUNDS``). Unless ``settings.refit_scene``, rounds fit only the paths
-    they add and the whole scene is fitted once at the end (with ``fit_at_end``; else ``fitted``
-    is False and the caller fits it), also when no round added a path to a ``drafted`` scene (one
-    given a draft fit only)."""
+    impact, however small, until the scene has ``pool`` paths or a round finds nothing more even
+    with its error bars halved `BUDGET_EASINGS` times (at most ``2 * MAX_AUTO_ROUNDS`` rounds).
+    Unless ``settings.refit_scene``, rounds fit only the paths they add and the whole scene is
+    fitted once at the end (with ``fit_at_end``; else ``fitted`` is False and the caller fits
+    it), also when no round added a path to a ``drafted`` scene (one given a draft fit only)."""
     settings, trace, fit = stages
     full_at = None
     if pool is not None:
@@ -240,6 +244,7 @@ def add_missing_rounds(
     planned = settings.rounds
     most = planned if planned is not None else MAX_AUTO_ROUNDS * (2 if pool else 1)
     automatic = planned is None and pool is None  # rounds until the gain falls off
+    eased = 0
     done = MissingRounds(scene)
     render = scene.render()
     error = _mse(render, target)
@@ -257,7 +262,12 @@ def add_missing_rounds(
         if on_round is not None:
             on_round(done.rounds, round_)
         if round_.added == 0:
+            if pool is not None and eased < BUDGET_EASINGS:
+                settings, eased = eased_settings(settings), eased + 1
+                continue
             done.stopped = "no region left that a new path improves"
+            if eased:
+                done.stopped += f", even at 1/{2**eased} of the error bars"
             break
         new_render = round_.scene.render()
         now = _mse(new_render, target)
@@ -279,6 +289,20 @@ def add_missing_rounds(
     done.scene = scene
     done.stopped = done.stopped or f"{done.rounds} rounds"
     return done
+
+
+def eased_settings(settings: MissingSettings) -> MissingSettings:
+    """``settings`` with its error bars halved: prompts where the averaged error reaches ω / 2,
+    wrong pixels and marks at half the error."""
+    marks = settings.marks
+    if marks is not None:
+        marks = replace(marks, pixel_error=marks.pixel_error / 2)
+    return replace(
+        settings,
+        threshold=settings.threshold / 2,
+        pixel_error=settings.pixel_error / 2,
+        marks=marks,
+    )
 
 
 def _mse(render: np.ndarray, target: np.ndarray) -> float:

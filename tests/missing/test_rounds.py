@@ -1,9 +1,17 @@
 """Stage 4 repeated: colour regions the render gets wrong, automatic rounds that stop when
 nothing more helps, and a path budget's pool."""
 
+from dataclasses import replace
+
 import numpy as np
 
-from samvg.missing.stage import MissingSettings, add_missing_rounds, offer_wrong_regions
+from samvg.missing.marks import MarkSettings
+from samvg.missing.stage import (
+    MissingSettings,
+    add_missing_rounds,
+    eased_settings,
+    offer_wrong_regions,
+)
 from samvg.optimize import FitSettings
 from samvg.scene import Scene
 from samvg.segment import ImpactCanvas
@@ -73,8 +81,6 @@ def test_a_set_number_of_rounds_runs_exactly_that_many():
 
 
 def test_an_automatic_round_that_raises_the_error_is_rolled_back():
-    from dataclasses import replace
-
     wild = FitSettings(steps=4, point_learning_rate=40.0, colour_learning_rate=1.0)
     automatic = (replace(settings(), refit_scene=False), STAGES[1], wild)
     done = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), automatic)
@@ -132,3 +138,22 @@ def test_a_drafted_scene_is_fitted_in_full_even_when_no_round_adds_a_path():
     assert not np.allclose(refitted.scene.points, drafted.points)
     error = np.mean((refitted.scene.render() - image) ** 2)
     assert error < np.mean((drafted.render() - image) ** 2)
+
+
+def test_a_budget_pool_eases_the_error_bars_before_it_gives_up():
+    image = target()
+    image[4:20, 40:56] = 0.93  # off white by 0.21 over RGB: below the bar of 0.25
+    unbudgeted = add_missing_rounds(blank_scene(), image, SilentSegmenter(), STAGES)
+    assert unbudgeted.added == 3  # the faint square is left for a budget to fill
+    done = add_missing_rounds(blank_scene(), image, SilentSegmenter(), STAGES, pool=10)
+    assert done.added == 4 and done.scene.path_count == 4
+    assert "even at 1/8 of the error bars" in done.stopped
+    faint = done.scene.render()[4:20, 40:56]
+    assert np.abs(faint - 0.93).max() < 0.02
+
+
+def test_eased_settings_halve_every_error_bar():
+    eased = eased_settings(replace(settings(), marks=MarkSettings(pixel_error=0.15)))
+    assert eased.threshold == 0.25 and eased.pixel_error == 0.125
+    assert eased.marks is not None and eased.marks.pixel_error == 0.075
+    assert eased.impact_threshold == settings().impact_threshold
