@@ -6,7 +6,7 @@ import argparse
 import importlib.util
 import shlex
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +16,12 @@ from samvg.bench.runner import run_bench
 from samvg.config import Config
 from samvg.errors import SamvgError
 
+#: samvg's presets by name, as ``samvg vectorize --preset`` knows them.
+PRESETS: dict[str, Callable[[], Config]] = {
+    "default": Config,
+    "paper": Config.paper,
+    "fast": Config.fast,
+}
 BENCH_EXTRA = "pip install 'samvg[bench]'"
 #: Optional modules (the ``bench`` extra): what needs each, and the methods that need it (None:
 #: every run, for the report's plots).
@@ -71,8 +77,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--iterations", type=int, help="optimization steps per phase")
     parser.add_argument("--seed", type=int, help="random seed (samvg and the baselines)")
     parser.add_argument(
-        "--fast", action="store_true", help="start from samvg's fast preset (Config.fast())"
+        "--preset",
+        choices=tuple(PRESETS),
+        default="default",
+        help="samvg's settings to start from: default, paper (the paper's exact procedure, for "
+        "its Tables 1 and 2) or fast",
     )
+    parser.add_argument("--fast", action="store_true", help="same as --preset fast")
     parser.add_argument("--checkpoint", help="SAM checkpoint file")
     parser.add_argument("--lpips-weights", help="LPIPS weights file (else the usual lookup)")
     parser.add_argument("--fid-weights", help="FID Inception weights (else the usual lookup)")
@@ -146,7 +157,7 @@ def _run(arguments: argparse.Namespace, console: Any, command: str) -> None:
         return
     if arguments.manifest is None:
         raise SamvgError("--manifest is required (except with --report-only)")
-    config = Config.fast() if arguments.fast else Config()
+    config = PRESETS["fast" if arguments.fast else arguments.preset]()
     if arguments.checkpoint:
         config = config.replace(checkpoint=arguments.checkpoint)
     if arguments.lpips_weights:

@@ -233,6 +233,33 @@ def test_cli_runs_and_resumes(tiny_manifest, tmp_path, lpips_file, monkeypatch, 
     assert "0 results made, 4 already there" in capsys.readouterr().err
 
 
+def test_cli_preset_paper_runs_the_papers_procedure(
+    tiny_manifest, tmp_path, lpips_file, monkeypatch, capsys
+):
+    """``--preset paper`` (Tables 1 and 2) starts from Config.paper; resuming the folder with
+    another preset is refused with the settings that differ."""
+    seen: list[Config] = []
+
+    def recording_samvg(job: MethodRun):
+        seen.append(job.config)
+        return stand_in_samvg(job)
+
+    monkeypatch.setitem(METHODS, "samvg", Method("samvg", recording_samvg))
+    out = tmp_path / "paper"
+    arguments = ["--manifest", str(tiny_manifest), "--out", str(out), "--methods", "samvg"]
+    arguments += ["--size", "64", "--iterations", "2", "--limit", "1", "--no-fid"]
+    arguments += ["--lpips-weights", str(lpips_file)]
+    assert main([*arguments, "--preset", "paper"]) == 0
+    paper = Config.paper()
+    assert [config.segment.points_per_side for config in seen] == [32]
+    assert seen[0].trace == paper.trace and seen[0].missing == paper.missing
+    settings = json.loads((out / "run.json").read_text())["settings"]
+    assert settings["finish_pass"] is False and settings["translucent"] is True
+    capsys.readouterr()
+    assert main(arguments) == 1
+    assert "points_per_side: 32 -> 16" in capsys.readouterr().err
+
+
 def test_cli_reports_mistakes_plainly(tmp_path, capsys):
     assert main(["--out", str(tmp_path / "o"), "--manifest", str(tmp_path / "no.csv")]) == 1
     assert "manifest not found" in capsys.readouterr().err
