@@ -513,8 +513,8 @@ def _add_vectorize_command(commands: Any) -> None:
         choices=("default", "paper", "fast"),
         default="default",
         help="default: segments per outline, opaque fills, finish pass; paper: the paper's "
-        "exact procedure (32x32 grid, 5 segments, learned opacity, no finish pass); fast: the "
-        "default with an 8x8 grid, at 384 px, 120 steps a phase, no LPIPS",
+        "exact procedure (32x32 grid with crops, 5 segments, learned opacity, no finish pass); "
+        "fast: the default with an 8x8 grid, at 384 px, 120 steps a phase, no LPIPS",
     )
     vectorize.add_argument("--fast", action="store_true", help="same as --preset fast")
     _add_tuning_options(vectorize)

@@ -376,8 +376,9 @@ class Config:
 
     @classmethod
     def paper(cls, **overrides: Any) -> Config:
-        """The paper's procedure: 32x32 grid, 5 segments a path, learned opacity, no bounds,
-        500 + 500 steps with LPIPS, one stage-4 round, no finish pass."""
+        """The paper's procedure: 32x32 grid with one layer of crops, 5 segments a path,
+        learned opacity, no bounds, 500 + 500 steps with LPIPS, one stage-4 round, no finish
+        pass."""
         return cls(**{**PAPER, **overrides})
 
     @classmethod
@@ -409,6 +410,7 @@ _RUN = ("size", "seed", "device", "threads")
 #: How `Config.paper` differs from the default.
 PAPER: dict[str, Any] = {
     "points_per_side": 32,
+    "crop_n_layers": 1,
     "segments": 5,
     "reshape": False,
     "translucent": True,

@@ -25,6 +25,7 @@ def test_settings_by_name_land_in_their_stage_group():
 
 def test_presets_and_replace():
     assert Config.paper() != Config() and Config.paper().trace.segments == 5
+    assert Config.paper().segment.crop_n_layers == 1 and Config().segment.crop_n_layers == 0
     assert Config().trace.segments is None and not Config().fit.translucent
     fast = Config.fast(seed=3)
     assert fast.segment.points_per_side == 8 and not fast.fit.use_lpips and fast.seed == 3

@@ -30,7 +30,8 @@ MAX_AUTO_ROUNDS = 6
 BUDGET_POOL = 1.25
 #: Under a budget, a round that finds nothing halves stage 4's error bars (the prompts' ω, the
 #: wrong pixels' and the marks' error) and tries again, at most this many times: the budget is
-#: filled from the largest errors left, as LIVE fills it, before the scene is declared done.
+#: filled from the largest errors left, as LIVE fills it, before the scene is declared done. A
+#: round at eased bars keeps its paths only if they lower the error by ``gain_tolerance``.
 BUDGET_EASINGS = 3
 
 
@@ -261,17 +262,19 @@ def add_missing_rounds(
             done.timings[stage] = done.timings.get(stage, 0.0) + seconds
         if on_round is not None:
             on_round(done.rounds, round_)
-        if round_.added == 0:
+        kept = round_.added
+        if kept:
+            new_render = round_.scene.render()
+            now = _mse(new_render, target)
+            gain = (error - now) / max(error, 1e-12)
+            if eased and gain < settings.gain_tolerance:  # eased paths must earn their place
+                done.added, kept = done.added - kept, 0
+        if kept == 0:
             if pool is not None and eased < BUDGET_EASINGS:
                 settings, eased = eased_settings(settings), eased + 1
                 continue
-            done.stopped = "no region left that a new path improves"
-            if eased:
-                done.stopped += f", even at 1/{2**eased} of the error bars"
+            done.stopped = _nothing_left(eased, settings.gain_tolerance)
             break
-        new_render = round_.scene.render()
-        now = _mse(new_render, target)
-        gain = (error - now) / max(error, 1e-12)
         if automatic and gain <= 0:  # the round's paths made the picture worse: they go
             done.added -= round_.added
             done.stopped = f"round {done.rounds} would have raised the error: rolled back"
@@ -289,6 +292,15 @@ def add_missing_rounds(
     done.scene = scene
     done.stopped = done.stopped or f"{done.rounds} rounds"
     return done
+
+
+def _nothing_left(eased: int, tolerance: float) -> str:
+    if not eased:
+        return "no region left that a new path improves"
+    return (
+        f"no region left that a new path improves by {tolerance:.0%}, even at 1/{2**eased} of "
+        "the error bars"
+    )
 
 
 def eased_settings(settings: MissingSettings) -> MissingSettings:

@@ -152,6 +152,15 @@ def test_a_budget_pool_eases_the_error_bars_before_it_gives_up():
     assert np.abs(faint - 0.93).max() < 0.02
 
 
+def test_paths_found_at_eased_error_bars_must_lower_the_error_by_the_tolerance():
+    image = target()
+    image[4:20, 40:56] = 0.93
+    strict = (replace(settings(), gain_tolerance=1.0), *STAGES[1:])  # no round gains 100 %
+    done = add_missing_rounds(blank_scene(), image, SilentSegmenter(), strict, pool=10)
+    assert done.added == 3 and done.scene.path_count == 3  # the faint square was rolled back
+    assert "improves by 100%, even at 1/8 of the error bars" in done.stopped
+
+
 def test_eased_settings_halve_every_error_bar():
     eased = eased_settings(replace(settings(), marks=MarkSettings(pixel_error=0.15)))
     assert eased.threshold == 0.25 and eased.pixel_error == 0.125
