@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import json
 import os
 import time
@@ -189,6 +190,16 @@ def _error_text(error: BaseException) -> str:
     return f"{type(error).__name__}: {text}"
 
 
+def categories_in_turn(images: Sequence[BenchImage]) -> list[BenchImage]:
+    """``images`` taking their categories in turn (the first of each, then the second ...), so
+    that a run stopped part way has results in every category."""
+    by_category: dict[str, list[BenchImage]] = {}
+    for image in images:
+        by_category.setdefault(image.category, []).append(image)
+    rounds = itertools.zip_longest(*by_category.values())
+    return [image for round_ in rounds for image in round_ if image is not None]
+
+
 def run_bench(
     manifest: str | os.PathLike[str],
     out: str | os.PathLike[str],
@@ -211,7 +222,8 @@ def run_bench(
 ) -> BenchOutcome:
     """Run ``methods`` on the manifest's images into ``out``, then write the report.
 
-    ``config`` (default :class:`samvg.Config`) is used with ``size`` and, if given,
+    Images take their categories in turn (`categories_in_turn`). ``config`` (default
+    :class:`samvg.Config`) is used with ``size`` and, if given,
     ``iterations`` and ``seed``. Results already in ``out`` are kept and skipped (failed ones
     too unless ``retry_failed``); ``out`` must have been made with the same settings.
     ``command`` (the command line) is kept in run.json and shown in the summary; ``fid=False``
@@ -237,7 +249,7 @@ def run_bench(
     outcome.skipped = len(images) * len(planned) - total
     scorer = Scorer(lpips_weights) if total else None
     reporter.start(total)
-    for image in images:
+    for image in categories_in_turn(images):
         todo = [method for method in planned if pending(image, method)]
         if todo:
             assert scorer is not None

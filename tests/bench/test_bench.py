@@ -11,7 +11,7 @@ from samvg import Config, InputError, VectorImage
 from samvg.baselines import random_init
 from samvg.bench import METHODS, Method, MethodRun, read_manifest, run_bench, write_report
 from samvg.bench.cli import main
-from samvg.bench.runner import plan_methods
+from samvg.bench.runner import categories_in_turn, plan_methods
 
 TINY = {"size": 64, "iterations": 3}
 
@@ -258,6 +258,17 @@ def test_cli_preset_paper_runs_the_papers_procedure(
     capsys.readouterr()
     assert main(arguments) == 1
     assert "points_per_side: 32 -> 16" in capsys.readouterr().err
+
+
+def test_a_run_takes_the_categories_in_turn(tmp_path):
+    rows = [("p1", "photo"), ("p2", "photo"), ("p3", "photo"), ("e1", "emoji"), ("i1", "icon")]
+    manifest = tmp_path / "manifest.csv"
+    manifest.write_text(
+        "id,category,png\n" + "".join(f"{i},{c},{i}.png\n" for i, c in rows), encoding="utf-8"
+    )
+    images = read_manifest(manifest)
+    order = [image.id for image in categories_in_turn(images)]
+    assert order == ["p1", "e1", "i1", "p2", "p3"]
 
 
 def test_cli_reports_mistakes_plainly(tmp_path, capsys):
