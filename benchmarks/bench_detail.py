@@ -181,6 +181,12 @@ def main() -> None:
         "time-against-paths plot reads benchmarks/results/speed/paths)",
     )
     parser.add_argument(
+        "--fallback",
+        type=Path,
+        help="report: budget records missing from --records are taken from this folder (an "
+        "older commit's baselines)",
+    )
+    parser.add_argument(
         "--geometry",
         type=Path,
         action="append",
@@ -193,7 +199,7 @@ def main() -> None:
         from detail_report import write_report
 
         budget = arguments.records if arguments.records != RECORDS else None
-        write_report(RECORDS, arguments.geometry or [GEOMETRY], budget)
+        write_report(RECORDS, arguments.geometry or [GEOMETRY], budget, arguments.fallback)
         return
     categories = arguments.categories.split(",") if arguments.categories else None
     if arguments.study == "rate" and categories is None:

@@ -78,7 +78,9 @@ def default_table(geometry: Path) -> list[str]:
     return lines
 
 
-def budget_tables(records: list[dict[str, Any]], folder: Path) -> list[str]:
+def budget_tables(
+    records: list[dict[str, Any]], folder: Path, fallback: Path | None = None
+) -> list[str]:
     """Per budget and category: each method's means, and samvg's wins against each baseline
     (lower MSE and lower LPIPS on the same image). samvg is its default (gradient fills) where
     those records exist, else flat fills."""
@@ -98,7 +100,12 @@ def budget_tables(records: list[dict[str, Any]], folder: Path) -> list[str]:
         "N (`samvg.baselines.vtracer_trace`); the LIVE-style baseline and random init (diffvg) "
         f"fitted with samvg's losses for {2 * 500} steps. Means over the images that have every "
         "method's record; *wins* = images where samvg has lower MSE **and** lower LPIPS than "
-        "that method (the goal: ≥ 90 % in every category).",
+        "that method (the goal: ≥ 90 % in every category)."
+        + (
+            f" Records that folder lacks come from `{_shown(fallback)}` (`--fallback`)."
+            if fallback is not None
+            else ""
+        ),
     ]
     lines += _wins_summary(by_key, subject)
     for budget in sorted({b for b, _ in by_key}):
@@ -315,8 +322,25 @@ def _subject(rows: list[dict[str, Any]]) -> str:
     return "samvg-gradients" if any(r["method"] == "samvg-gradients" for r in rows) else "samvg"
 
 
+def with_fallback(records: list[dict[str, Any]], fallback: Path | None) -> list[dict[str, Any]]:
+    """``records`` and the budget records of ``fallback`` for the (image, method, budget) they
+    lack (an older commit's baselines, or budgets not rerun)."""
+    if fallback is None:
+        return records
+    have = {(r["id"], r["method"], r.get("budget")) for r in records}
+    extra = [
+        r
+        for r in _records(fallback, "*.json")
+        if (r["id"], r["method"], r.get("budget")) not in have
+    ]
+    return records + extra
+
+
 def write_report(
-    records_folder: Path, geometry: list[Path], budget_folder: Path | None = None
+    records_folder: Path,
+    geometry: list[Path],
+    budget_folder: Path | None = None,
+    fallback: Path | None = None,
 ) -> None:
     """detail.md from the records: the default against VTracer (a table per folder of
     ``geometry``), the equal-budget
@@ -325,7 +349,7 @@ def write_report(
     VTracer's sweep from ``records_folder``)."""
     records = _records(records_folder, "*.json")
     budget_folder = budget_folder or records_folder
-    budget_records = _records(budget_folder, "*.json")
+    budget_records = with_fallback(_records(budget_folder, "*.json"), fallback)
     lines = [
         "# Detail at any path budget (issue 11)",
         "",
@@ -334,7 +358,7 @@ def write_report(
         "",
         *[line for folder in geometry for line in (*default_table(folder), "")],
         "",
-        *budget_tables(budget_records, budget_folder),
+        *budget_tables(budget_records, budget_folder, fallback),
         *gradient_table(records),
         *rate_plot(records, budget_records),
     ]
