@@ -22,6 +22,21 @@ RED, BLUE = (0.9, 0.1, 0.1), (0.1, 0.2, 0.8)
 SPLIT = ColourSplitSettings(min_pixels=8)
 
 
+class FaintSquareSegmenter:
+    """SAM's stand-in that finds the faint square of `faint_target` at any prompt inside it."""
+
+    def prompt(self, points: np.ndarray) -> list[list[np.ndarray]]:
+        square = np.zeros((64, 64), bool)
+        square[4:20, 40:56] = True
+        return [[square] if square[int(y), int(x)] else [] for x, y in points]
+
+
+def faint_target() -> np.ndarray:
+    image = target()
+    image[4:20, 40:56] = 0.93  # off white by 0.21 over RGB: below the bars of 0.5 and 0.25
+    return image
+
+
 class SilentSegmenter:
     """SAM's stand-in that finds nothing: only the colour regions can add paths."""
 
@@ -141,11 +156,10 @@ def test_a_drafted_scene_is_fitted_in_full_even_when_no_round_adds_a_path():
 
 
 def test_a_budget_pool_eases_the_error_bars_before_it_gives_up():
-    image = target()
-    image[4:20, 40:56] = 0.93  # off white by 0.21 over RGB: below the bar of 0.25
-    unbudgeted = add_missing_rounds(blank_scene(), image, SilentSegmenter(), STAGES)
+    image, segmenter = faint_target(), FaintSquareSegmenter()
+    unbudgeted = add_missing_rounds(blank_scene(), image, segmenter, STAGES)
     assert unbudgeted.added == 3  # the faint square is left for a budget to fill
-    done = add_missing_rounds(blank_scene(), image, SilentSegmenter(), STAGES, pool=10)
+    done = add_missing_rounds(blank_scene(), image, segmenter, STAGES, pool=10)
     assert done.added == 4 and done.scene.path_count == 4
     assert "even at 1/8 of the error bars" in done.stopped
     faint = done.scene.render()[4:20, 40:56]
@@ -153,16 +167,16 @@ def test_a_budget_pool_eases_the_error_bars_before_it_gives_up():
 
 
 def test_paths_found_at_eased_error_bars_must_lower_the_error_by_the_tolerance():
-    image = target()
-    image[4:20, 40:56] = 0.93
     strict = (replace(settings(), gain_tolerance=1.0), *STAGES[1:])  # no round gains 100 %
-    done = add_missing_rounds(blank_scene(), image, SilentSegmenter(), strict, pool=10)
+    done = add_missing_rounds(
+        blank_scene(), faint_target(), FaintSquareSegmenter(), strict, pool=10
+    )
     assert done.added == 3 and done.scene.path_count == 3  # the faint square was rolled back
     assert "improves by 100%, even at 1/8 of the error bars" in done.stopped
 
 
-def test_eased_settings_halve_every_error_bar():
+def test_eased_settings_halve_the_prompts_and_marks_error_bars():
     eased = eased_settings(replace(settings(), marks=MarkSettings(pixel_error=0.15)))
-    assert eased.threshold == 0.25 and eased.pixel_error == 0.125
+    assert eased.threshold == 0.25 and eased.pixel_error == settings().pixel_error
     assert eased.marks is not None and eased.marks.pixel_error == 0.075
     assert eased.impact_threshold == settings().impact_threshold
