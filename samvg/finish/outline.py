@@ -137,7 +137,7 @@ def hole_free_pieces(polygon: shapely.Polygon, cuts: int = MAX_CUTS) -> list[sha
     """``polygon`` as polygons without holes that paint the same area together: cut across its
     largest hole of `HOLE_AREA` px² or more (along the hole's shorter side, through the middle
     of its bounds), each side reaching `CUT_OVERLAP` px over the cut, then each side the same
-    way. Smaller holes, and any left after ``cuts`` cuts, are filled."""
+    way. Smaller holes, any left after ``cuts`` cuts, and one a cut misses, are filled."""
     holes = [shapely.Polygon(ring) for ring in polygon.interiors]
     large = [hole for hole in holes if hole.area >= HOLE_AREA]
     if not large or cuts <= 0:
@@ -146,7 +146,10 @@ def hole_free_pieces(polygon: shapely.Polygon, cuts: int = MAX_CUTS) -> list[sha
     pieces = [part for side in _sides(polygon, hole) for part in _polygons_in(side)]
     inside = hole.point_on_surface()
     if any(shapely.Polygon(ring).contains(inside) for piece in pieces for ring in piece.interiors):
-        return [shapely.Polygon(polygon.exterior)]  # the cut missed the hole
+        # The cut missed (it cannot in exact arithmetic: the hole is at least 2 px across the
+        # cut): that hole alone is filled, and the others are cut round as usual.
+        others = [ring for ring in polygon.interiors if not shapely.Polygon(ring).equals(hole)]
+        return hole_free_pieces(shapely.Polygon(polygon.exterior, others), cuts - 1)
     budget = (cuts - 1) // max(1, len(pieces))
     return [whole for piece in pieces for whole in hole_free_pieces(piece, budget)]
 
