@@ -110,7 +110,12 @@ def main() -> None:
     t = time.perf_counter()
     pred.predict_points(pts)
     batched = (time.perf_counter() - t) / len(pts)
+    write_report(args, rows, (pt, one, batched, masks, scores))
 
+
+def write_report(args: argparse.Namespace, rows: list, prompt: tuple) -> None:
+    """sam.md from the AMG rows and the point-prompt measurements."""
+    pt, one, batched, masks, scores = prompt
     lines = [
         "# SAM (MobileSAM) CPU benchmark",
         "",
