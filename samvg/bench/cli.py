@@ -10,9 +10,10 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from samvg.bench.layout import Layout
 from samvg.bench.methods import DEFAULT_METHODS, METHODS
 from samvg.bench.report import write_report
-from samvg.bench.runner import run_bench
+from samvg.bench.runner import run_bench, write_results_csv
 from samvg.config import Config
 from samvg.errors import SamvgError
 
@@ -92,7 +93,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--retry-failed", action="store_true", help="run again what failed in an earlier run"
     )
     parser.add_argument(
-        "--report-only", action="store_true", help="only rewrite the report from --out"
+        "--report-only",
+        action="store_true",
+        help="only rewrite the report and results.csv from --out's records",
     )
     return parser
 
@@ -153,6 +156,7 @@ def _run(arguments: argparse.Namespace, console: Any, command: str) -> None:
         summary = write_report(
             arguments.out, fid_weights=arguments.fid_weights, fid=not arguments.no_fid
         )
+        write_results_csv(Layout(arguments.out))  # a run stopped part way wrote none yet
         console.print(f"wrote {summary}", markup=False, highlight=False, soft_wrap=True)
         return
     if arguments.manifest is None:

@@ -194,8 +194,11 @@ def test_report_in_the_papers_layout(tiny_manifest, tmp_path, lpips_file, fid_fi
     assert "n/a" not in fid_line
     for name in ("time_vs_paths.png", "mse_vs_paths.png", "contact_sheet.png"):
         assert (out / name).stat().st_size > 1000
-    # the report can be rewritten from the folder alone, by the CLI too
+    # the report can be rewritten from the folder alone, by the CLI too (results.csv with it)
+    rows = read_rows(out)
+    (out / "results.csv").unlink()
     assert main(["--out", str(out), "--report-only", "--no-fid"]) == 0
+    assert read_rows(out) == rows
     assert write_report(out, fid=False) == out / "summary.md"
     assert "| FID ↓ | n/a | n/a | n/a |" in (out / "summary.md").read_text()
 
