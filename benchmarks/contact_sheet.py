@@ -34,11 +34,11 @@ from PIL import Image, ImageDraw
 
 import samvg
 from samvg.baselines import render_svg
+from samvg.config import PRESETS
 from samvg.imaging import to_float_rgb
 
 CELL = 256
 CAPTION = 30
-PRESETS = {"default": samvg.Config, "paper": samvg.Config.paper, "fast": samvg.Config.fast}
 
 
 def cell(picture: np.ndarray, caption: str) -> Image.Image:

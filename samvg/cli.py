@@ -28,7 +28,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from samvg.config import Config
+from samvg.config import PRESETS, Config
 from samvg.errors import InputError, OutputError, SamvgError
 from samvg.io import read_image, write_png
 from samvg.output_paths import batch_outputs, check_output_file, check_output_folder
@@ -162,8 +162,7 @@ def _config(arguments: argparse.Namespace) -> Config:
     if arguments.no_finish:
         settings["finish_pass"] = False
     preset = "fast" if arguments.fast else arguments.preset
-    constructors = {"default": Config, "paper": Config.paper, "fast": Config.fast}
-    return constructors[preset](**settings)
+    return PRESETS[preset](**settings)
 
 
 def _expand_inputs(inputs: list[str]) -> tuple[list[Path], bool]:
@@ -510,7 +509,7 @@ def _add_vectorize_command(commands: Any) -> None:
     )
     vectorize.add_argument(
         "--preset",
-        choices=("default", "paper", "fast"),
+        choices=tuple(PRESETS),
         default="default",
         help="default: segments per outline, opaque fills, finish pass; paper: the paper's "
         "exact procedure (32x32 grid with crops, 5 segments, learned opacity, no finish pass); "

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -426,3 +427,9 @@ PAPER: dict[str, Any] = {
 }
 #: How `Config.fast` differs from the default.
 FAST: dict[str, Any] = {"points_per_side": 8, "size": 384, "iterations": 120, "use_lpips": False}
+#: The presets by name, as ``--preset`` knows them: each builds a `Config` from overrides.
+PRESETS: dict[str, Callable[..., Config]] = {
+    "default": Config,
+    "paper": Config.paper,
+    "fast": Config.fast,
+}

@@ -6,7 +6,7 @@ import argparse
 import importlib.util
 import shlex
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -14,15 +14,9 @@ from samvg.bench.layout import Layout
 from samvg.bench.methods import DEFAULT_METHODS, METHODS
 from samvg.bench.report import write_report
 from samvg.bench.runner import run_bench, write_results_csv
-from samvg.config import Config
+from samvg.config import PRESETS
 from samvg.errors import SamvgError
 
-#: samvg's presets by name, as ``samvg vectorize --preset`` knows them.
-PRESETS: dict[str, Callable[[], Config]] = {
-    "default": Config,
-    "paper": Config.paper,
-    "fast": Config.fast,
-}
 BENCH_EXTRA = "pip install 'samvg[bench]'"
 #: Optional modules (the ``bench`` extra): what needs each, and the methods that need it (None:
 #: every run, for the report's plots).
