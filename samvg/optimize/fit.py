@@ -139,16 +139,28 @@ class FitResult:
 
 @contextlib.contextmanager
 def fit_torch_threads(perceptual: bool) -> Iterator[None]:
-    """Run torch inside the block on the rasterizer's thread count (`render_threads`: the run's
-    ``threads``, or every core up to 8) for a fit with LPIPS, whose convolutions run about 1.6x
-    faster on two threads than on one; on one thread without it (the per-step tensors of MSE
-    and Xing are small: a thread pool costs more than it saves)."""
+    """Run torch inside the block on one thread: the per-step tensors of MSE and Xing are small
+    (a thread pool costs more than it saves), and torch's OpenMP workers, spinning after each
+    parallel operation, would take the cores from the rasterizer's threads (on two cores its
+    backward pass ran no faster on two threads than on one). LPIPS, whose convolutions run about
+    1.4x faster on two threads, gets the rasterizer's thread count on its own (`_Objective`).
+    ``perceptual`` is kept for callers that patch this function."""
+    del perceptual
+    with torch_threads(1):
+        yield
+
+
+@contextlib.contextmanager
+def torch_threads(count: int) -> Iterator[None]:
+    """torch's intra-op thread count set to ``count`` inside the block."""
     threads = torch.get_num_threads()
-    torch.set_num_threads(render_threads() if perceptual else 1)
+    if count != threads:
+        torch.set_num_threads(count)
     try:
         yield
     finally:
-        torch.set_num_threads(threads)
+        if count != threads:
+            torch.set_num_threads(threads)
 
 
 def _check_target(target: np.ndarray, scene: Scene) -> torch.Tensor:
@@ -404,10 +416,12 @@ def _plateaued(losses: list[float], window: int | None) -> bool:
 class _Objective:
     """MSE + λ_Xing · Xing + λ_LPIPS · LPIPS of a render.
 
-    With ``settings.perceptual_every`` k > 1, LPIPS and its gradient with respect to the render
-    are evaluated every k-th step only; the steps between add the linear term ⟨G, render⟩ with
-    the last gradient G, so every step still feels LPIPS while paying for it once in k (the
-    render changes little over a few steps). k = 1 is the exact objective.
+    LPIPS and its gradient G with respect to the render are computed apart, on the rasterizer's
+    thread count (`torch_threads`), and the loss to differentiate adds the linear term
+    ⟨G, render⟩, whose gradient is exactly LPIPS's. With ``settings.perceptual_every`` k > 1,
+    G is evaluated every k-th step only and the steps between reuse the last one, so every step
+    still feels LPIPS while paying for it once in k (the render changes little over a few
+    steps). k = 1 is the exact objective.
     """
 
     def __init__(
@@ -430,13 +444,11 @@ class _Objective:
         perceptual = settings.perceptual
         if perceptual is None or settings.perceptual_weight <= 0:
             return loss, float(loss.detach())
-        if settings.perceptual_every <= 1:
-            loss = loss + settings.perceptual_weight * perceptual(rendered)
-            return loss, float(loss.detach())
         if step % settings.perceptual_every == 0 or self.perceptual_gradient is None:
-            image = rendered.detach().requires_grad_(True)
-            value = perceptual(image)
-            (gradient,) = torch.autograd.grad(value, image)
+            with torch_threads(render_threads()):
+                image = rendered.detach().requires_grad_(True)
+                value = perceptual(image)
+                (gradient,) = torch.autograd.grad(value, image)
             self.perceptual_gradient = gradient * settings.perceptual_weight
             self.perceptual_value = settings.perceptual_weight * float(value.detach())
         reported = float(loss.detach()) + self.perceptual_value

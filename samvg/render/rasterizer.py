@@ -21,6 +21,7 @@ from samvg.render import _kernels as K
 from samvg.render._paint_kernels import FLAT, LINEAR, MAX_STOPS, PARAMS, RADIAL
 from samvg.render.gradient_image import gradient_image
 from samvg.render.threads import render_threads, run_parts
+from samvg.render.workspace import scratch
 from samvg.scene import FlatPaint, LinearGradient, Paint, RadialGradient, Scene
 
 #: Maximum chord error (pixels) of the polyline that replaces each cubic segment.
@@ -264,8 +265,8 @@ class _Rasterize(torch.autograd.Function):
             canvas = np.empty((height, width, 3), out_dtype)
             if bg.ndim == 3:
                 canvas[...] = bg
-            acc = np.empty(n_cells if keep else largest, np.float64)
-            under = np.empty((n_cells if keep else 0, 3), np.float32)
+            acc = scratch(n_cells if keep else largest, np.float64)
+            under = scratch((n_cells if keep else 0, 3), np.float32)
         except MemoryError as exc:
             raise InputError(
                 f"scene too large to rasterize: {n_cells} path-box pixels on a "
@@ -274,12 +275,14 @@ class _Rasterize(torch.autograd.Function):
         parts = min(render_threads(), height)
         bands = K.row_bands(box, height, parts)
         # With keep the bands fill disjoint rows of one buffer; without, each needs a scratch.
-        scratch = [acc] * parts if keep else [acc] + [np.empty_like(acc) for _ in range(parts - 1)]
+        buffers = [acc] * parts
+        if not keep:
+            buffers[1:] = [scratch(acc.shape, np.float64) for _ in range(1, parts)]
         fill = bg if bg.ndim == 1 else _NO_BACKGROUND
 
         def forward_band(part: int) -> None:
             K.render_forward(
-                verts, vstart, box, off, cols, fill, canvas, scratch[part],
+                verts, vstart, box, off, cols, fill, canvas, buffers[part],
                 under, keep, kinds, stops, paint, bands[part], bands[part + 1],
             )  # fmt: skip
 
@@ -297,7 +300,8 @@ class _Rasterize(torch.autograd.Function):
     @torch.autograd.function.once_differentiable
     def backward(ctx: Any, grad_out: torch.Tensor) -> tuple[torch.Tensor | None, ...]:
         n_ctrl, starts, seg_n, vstart, verts, box, off, acc, under, cols = ctx.state
-        go = np.array(grad_out.detach().cpu().numpy(), dtype=np.float64, order="C", copy=True)
+        go = scratch(tuple(grad_out.shape), np.float64)
+        go[...] = grad_out.detach().cpu().numpy()
         gverts, gcol, gpaint = _backward(go, verts, vstart, box, off, cols, acc, under, ctx.paints)
         g_pts = g_col = g_paint = g_image = None
         if ctx.needs_input_grad[0]:
@@ -337,7 +341,7 @@ def _backward(
     parts = min(render_threads(), height)
     colour_sums = np.zeros((parts, box.shape[0], 4), np.float64)
     paint_sums = np.zeros((parts, *paint.shape), np.float64)
-    dcov = np.empty(acc.shape[0], np.float64)
+    dcov = scratch(acc.shape[0], np.float64)
     rows = K.row_bands(box, height, parts)
 
     def pixel_band(part: int) -> None:
