@@ -26,10 +26,9 @@ from dataclasses import replace
 from typing import cast
 
 import numpy as np
-from skimage.draw import polygon as fill_polygon
 
 from samvg.errors import InputError
-from samvg.finish.flatten import flatten_paths
+from samvg.render import path_labels
 from samvg.scene import (
     BackgroundGradient,
     FlatPaint,
@@ -48,15 +47,9 @@ _LOW, _HIGH = 2.0, 98.0
 
 
 def shown_labels(scene: Scene) -> np.ndarray:
-    """(H, W) int: the index of the top path whose outline holds each pixel centre, -1 where
-    only the background shows (outlines filled by their polygons, in paint order)."""
-    labels = np.full((scene.height, scene.width), -1, dtype=np.int64)
-    vertices, offsets = flatten_paths(scene.points, scene.offsets)
-    for index in range(scene.path_count):
-        ring = vertices[offsets[index] : offsets[index + 1]] - 0.5  # pixel centres
-        rows, cols = fill_polygon(ring[:, 1], ring[:, 0], labels.shape)
-        labels[rows, cols] = index
-    return labels
+    """(H, W) int: the index of the top path covering at least half of each pixel, -1 where only
+    the background shows (`samvg.render.path_labels`)."""
+    return path_labels(scene)
 
 
 def _line_fit(position: np.ndarray, colours: np.ndarray) -> tuple[np.ndarray, float]:
