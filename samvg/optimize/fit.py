@@ -10,6 +10,7 @@ from typing import cast
 
 import numpy as np
 import torch
+from torch.nn import functional
 
 from samvg.config import FitOptions
 from samvg.errors import InputError, SamvgError
@@ -438,7 +439,7 @@ class _Objective:
     ) -> tuple[torch.Tensor, float]:
         """The loss to differentiate and the objective's value to report."""
         settings = self.settings
-        loss = torch.mean((rendered - self.target) ** 2)
+        loss = functional.mse_loss(rendered, self.target)
         if settings.xing_weight > 0:
             loss = loss + settings.xing_weight * xing_loss(points, indices=self.indices)
         perceptual = settings.perceptual
