@@ -28,7 +28,8 @@ from typing import cast
 import numpy as np
 
 from samvg.errors import InputError
-from samvg.render import path_labels
+from samvg.finish.flatten import flatten_paths
+from samvg.optimize._labels import fill_outlines
 from samvg.scene import (
     BackgroundGradient,
     FlatPaint,
@@ -47,9 +48,12 @@ _LOW, _HIGH = 2.0, 98.0
 
 
 def shown_labels(scene: Scene) -> np.ndarray:
-    """(H, W) int: the index of the top path covering at least half of each pixel, -1 where only
-    the background shows (`samvg.render.path_labels`)."""
-    return path_labels(scene)
+    """(H, W) int: the index of the top path whose outline holds each pixel centre, -1 where
+    only the background shows (outlines filled by their polygons, in paint order)."""
+    labels = np.full((scene.height, scene.width), -1, dtype=np.int64)
+    vertices, offsets = flatten_paths(scene.points, scene.offsets)
+    fill_outlines(np.ascontiguousarray(vertices, np.float64), np.asarray(offsets, np.int64), labels)
+    return labels
 
 
 def _line_fit(position: np.ndarray, colours: np.ndarray) -> tuple[np.ndarray, float]:

@@ -2,8 +2,7 @@
 
 Public API: ``rasterize(points, colors, width, height, background)``, ``render_array`` (the same
 for numpy arrays, no gradients), ``render_scene``, ``gradient_image`` (a gradient over the whole
-canvas, in torch: a gradient background), ``background_image``, ``path_labels`` (which path shows
-at each pixel) and ``warmup()``.
+canvas, in torch: a gradient background), ``background_image`` and ``warmup()``.
 Written by hand because no maintained library does exact-area differentiable rasterization of
 vector paths on the CPU; see ``samvg.render._kernels`` for the method.
 """
@@ -13,7 +12,6 @@ from samvg.render.rasterizer import (
     FLATTEN_TOLERANCE,
     MAX_PIXELS,
     background_image,
-    path_labels,
     rasterize,
     render_array,
     render_scene,
@@ -25,7 +23,6 @@ __all__ = [
     "MAX_PIXELS",
     "background_image",
     "gradient_image",
-    "path_labels",
     "rasterize",
     "render_array",
     "render_scene",

@@ -321,31 +321,6 @@ def _path_deposits(
 
 
 @njit(cache=True, nogil=True)
-def label_paths(
-    verts: np.ndarray, path_vstart: np.ndarray, box: np.ndarray, labels: np.ndarray,
-    acc: np.ndarray,
-) -> None:  # fmt: skip
-    """Write into ``labels`` (H, W) the index of the top path that covers at least half of each
-    pixel (nonzero rule, the coverage `render_forward` draws with); other pixels keep what the
-    caller put there. ``acc`` is scratch of the largest box."""
-    for p in range(box.shape[0]):
-        bw = box[p, 2]
-        bh = box[p, 3]
-        if bw <= 0 or bh <= 0:
-            continue
-        bx0 = box[p, 0]
-        by0 = box[p, 1]
-        _path_deposits(verts, path_vstart[p], path_vstart[p + 1], bx0, by0, bw, bh, acc, 0, 0, bh)
-        stride = bw + 1
-        for r in range(bh):
-            wind = 0.0
-            for c in range(bw):
-                wind += acc[r * stride + c]
-                if abs(wind) >= 0.5:
-                    labels[by0 + r, bx0 + c] = p
-
-
-@njit(cache=True, nogil=True)
 def row_bands(box: np.ndarray, height: int, parts: int) -> np.ndarray:
     """``parts + 1`` row boundaries that split the canvas into bands of about equal work (the
     box pixels of all paths in each band; a band may be empty)."""

@@ -445,20 +445,6 @@ def rasterize(
         raise InputError(f"canvas {width}x{height} is too large to allocate") from exc
 
 
-def path_labels(scene: Scene, tolerance: float = FLATTEN_TOLERANCE) -> np.ndarray:
-    """(H, W) int64: the index of the top path covering at least half of each pixel of the
-    scene's canvas (as `rasterize` computes coverage), -1 where only the background shows."""
-    flat, starts = _packed_points(np.asarray(scene.points, np.float64), scene.offsets)
-    points = np.ascontiguousarray(flat.numpy())
-    _report_nonfinite(points, starts, "coordinates")
-    labels = np.full((scene.height, scene.width), -1, np.int64)
-    _, vstart, verts = K.plan_and_flatten(points, starts, scene.width, scene.height, tolerance)
-    box, off = K.path_boxes(verts, vstart, scene.width, scene.height)
-    largest = int(np.max(np.diff(off))) if len(off) > 1 else 0
-    K.label_paths(verts, vstart, box, labels, scratch(largest, np.float64))
-    return labels
-
-
 def render_array(
     points: np.ndarray,
     colors: np.ndarray,
@@ -539,8 +525,3 @@ def warmup() -> None:
     ramp = torch.zeros(PARAMS, dtype=torch.float64)
     ramp[2], ramp[5] = 4.0, 1.0
     gradient_image(LINEAR, 2, ramp.requires_grad_(True), 4, 4).sum().backward()
-    # Which path shows where (gradient fills are fitted over those pixels).
-    square = np.array([[1.0, 1.0], [3.0, 1.0], [3.0, 3.0], [1.0, 3.0]])
-    K.label_paths(
-        square, np.array([0, 4]), np.array([[0, 0, 4, 4]]), np.full((4, 4), -1), np.zeros(20)
-    )
