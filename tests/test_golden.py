@@ -7,12 +7,16 @@ optimization of crossing paths lets last-bit differences grow into visibly diffe
 So every machine checks what carries over (the same paths, each image as close to its target
 as the golden one, rendered by resvg), and the machine the files were written on (named in
 ``tests/data/golden/MACHINE``) also checks the bytes. The files were last written on
-2026-12-03, with one decimal (the writer's default since), on the CI machine of that day; the
+2026-12-04, with one decimal (the writer's default since), on the CI machine of that day; the
 runs pin the rasterizer to one thread, whose colour-gradient sums are those of the
 single-threaded kernels.
+
+To rewrite the files after a change of behaviour made on purpose, run this module with
+``SAMVG_REWRITE_GOLDEN=1`` on the CI machine: each case writes its SVG and ``MACHINE`` first.
 """
 
 import functools
+import os
 import platform
 from pathlib import Path
 
@@ -101,7 +105,11 @@ def run(name, preset, bench_dir, sam_checkpoint, lpips_weights) -> tuple[str, st
     """(the SVG written now, the golden SVG) for one image and preset."""
     source = source_image(name, bench_dir)
     svg = vectorized(name, preset, source, sam_checkpoint, lpips_weights)
-    return svg, (GOLDEN / f"{name}.{preset}.svg").read_text(encoding="utf-8")
+    golden = GOLDEN / f"{name}.{preset}.svg"
+    if os.environ.get("SAMVG_REWRITE_GOLDEN") == "1":
+        golden.write_text(svg, encoding="utf-8")
+        (GOLDEN / "MACHINE").write_text(this_machine() + "\n", encoding="utf-8")
+    return svg, golden.read_text(encoding="utf-8")
 
 
 @pytest.mark.slow
