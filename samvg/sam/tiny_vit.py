@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import cast
 
 import torch
 import torch.nn.functional as F
@@ -33,7 +34,7 @@ class Conv2dBN(nn.Sequential):
         is kept and ``load_state_dict`` stays safe)."""
         if self.training:
             return super().forward(x)
-        conv, bn = self.c, self.bn
+        conv, bn = cast(nn.Conv2d, self.c), cast(nn.BatchNorm2d, self.bn)
         assert bn.running_var is not None and bn.running_mean is not None
         scale = bn.weight * torch.rsqrt(bn.running_var + bn.eps)
         weight = conv.weight * scale.view(-1, 1, 1, 1)
