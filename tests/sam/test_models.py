@@ -8,7 +8,7 @@ import torch
 from samvg.errors import WeightsError
 from samvg.sam import build_sam, load_sam
 from samvg.sam.build import read_checkpoint
-from samvg.sam.tiny_vit import TinyViT
+from samvg.sam.tiny_vit import Conv2dBN, TinyViT
 
 
 def test_real_checkpoint_strict(sam_checkpoint, sam_model):
@@ -113,3 +113,28 @@ def test_tiny_vit_roundtrip_strict(tmp_path):
     other = build_sam("vit_b", **{**cfg, "depth": 3})
     with pytest.raises(WeightsError, match="missing keys"):
         check_state_dict(other, state, "vit_b", str(path))
+
+
+def test_folded_conv_bn_equals_conv_then_batchnorm():
+    torch.manual_seed(0)
+    layer = Conv2dBN(8, 8, 3, 1, 1, groups=8)
+    bn = layer.bn
+    with torch.no_grad():
+        bn.running_mean.uniform_(-1, 1)
+        bn.running_var.uniform_(0.5, 2)
+        bn.weight.uniform_(0.5, 1.5)
+        bn.bias.uniform_(-0.5, 0.5)
+    layer.eval()
+    x = torch.randn(2, 8, 16, 16).contiguous(memory_format=torch.channels_last)
+    with torch.no_grad():
+        reference = bn(layer.c(x))
+        folded = layer(x)
+    torch.testing.assert_close(folded, reference, atol=1e-5, rtol=1e-5)
+    assert layer.state_dict().keys() == {
+        "c.weight",
+        "bn.weight",
+        "bn.bias",
+        "bn.running_mean",
+        "bn.running_var",
+        "bn.num_batches_tracked",
+    }
