@@ -486,7 +486,7 @@ def _add_shape_options(vectorize: argparse.ArgumentParser) -> None:
     vectorize.add_argument(
         "--no-finish",
         action="store_true",
-        help="skip the finish pass (untangling, bounds, hidden paths, merges)",
+        help="skip the finish pass (untangling, bounds, hidden and idle paths, merges)",
     )
 
 

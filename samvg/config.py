@@ -213,14 +213,17 @@ class FitOptions:
 
 @dataclass(frozen=True)
 class FinishOptions:
-    """The finish pass: simple, bounded paths, hidden paths removed, touching paths of near-equal
-    colour merged, optionally a palette (see `samvg.finish`)."""
+    """The finish pass: simple, bounded paths, hidden and idle paths removed, touching paths of
+    near-equal colour merged, optionally a palette (see `samvg.finish`)."""
 
     finish_pass: bool = True
     """Run the finish pass (the paper has none)."""
     colors: int | None = None
     """Snap the fills to this many colours (k-means in CIELAB), like Illustrator's colours."""
     remove_hidden: bool = True
+    remove_idle: bool = True
+    """Remove the paths whose removal changes the picture by less than ``IDLE_COST`` of MSE (a
+    path painted over its own colour, a sliver under a neighbour's edge): bytes for nothing."""
     merge_paths: bool = True
 
     def __post_init__(self) -> None:

@@ -36,7 +36,7 @@ from samvg.missing import MissingSettings
 from samvg.missing.stage import BUDGET_POOL, MAX_AUTO_ROUNDS, add_missing_rounds
 from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import margin_box
-from samvg.optimize.reduce import reduce_paths
+from samvg.optimize.reduce import IDLE_COST, reduce_paths, remove_idle_paths
 from samvg.optimize.reshape import reshape_scene
 from samvg.render.threads import using_render_threads
 from samvg.sam import SPECS
@@ -290,9 +290,12 @@ def _finish_pass(
         settings = replace(_finish_settings(config, inputs), background_from_path=background)
         finished = finish_scene(scene, settings)
         scene = _within(finished.scene.with_fixed_from(scene), config, by_area=True)
-        for name, count in finished.counts.items():
+        counts = dict(finished.counts)
+        if config.finish.remove_idle:
+            scene, counts["idle_removed"] = remove_idle_paths(scene, inputs.target, IDLE_COST)
+        for name, count in counts.items():
             result.counts[name] = result.counts.get(name, 0) + count
-        result.notes.append(_finish_note(finished.counts))
+        result.notes.append(_finish_note(counts))
         report("finish", 1, 1)
     return scene
 
@@ -466,7 +469,8 @@ def _finish_note(counts: dict[str, int]) -> str:
         f"finish: {counts.get('simple_repaired', 0)} self-crossing paths repaired "
         f"({counts.get('simple_split', 0)} parts split off), "
         f"{counts.get('bounds_clipped', 0)} clipped to the canvas, "
-        f"{counts.get('hidden_removed', 0)} hidden paths removed, "
+        f"{counts.get('hidden_removed', 0)} hidden and {counts.get('idle_removed', 0)} idle "
+        "paths removed, "
         f"{counts.get('merged', 0)} merged"
         + (", the path over the whole canvas made the background"
            if counts.get("background_from_path") else "")

@@ -58,6 +58,10 @@ class FlatPaint:
         """The paint on a canvas scaled by ``factor`` (a flat fill has no geometry)."""
         return self
 
+    def shifted(self, _dx: float, _dy: float) -> FlatPaint:
+        """The paint with the canvas origin moved (a flat fill has no geometry)."""
+        return self
+
 
 Stop = tuple[float, RGB]
 """A gradient stop: offset in [0, 1] and RGB in [0, 1]."""
@@ -134,6 +138,10 @@ class LinearGradient(_Gradient):
         start = (self.start[0] * factor, self.start[1] * factor)
         return replace(self, start=start, end=(self.end[0] * factor, self.end[1] * factor))
 
+    def shifted(self, dx: float, dy: float) -> LinearGradient:
+        start = (self.start[0] + dx, self.start[1] + dy)
+        return replace(self, start=start, end=(self.end[0] + dx, self.end[1] + dy))
+
 
 @dataclass(frozen=True)
 class RadialGradient(_Gradient):
@@ -155,6 +163,9 @@ class RadialGradient(_Gradient):
     def scaled(self, factor: float) -> RadialGradient:
         centre = (self.centre[0] * factor, self.centre[1] * factor)
         return replace(self, centre=centre, radius=self.radius * factor)
+
+    def shifted(self, dx: float, dy: float) -> RadialGradient:
+        return replace(self, centre=(self.centre[0] + dx, self.centre[1] + dy))
 
 
 Paint = FlatPaint | LinearGradient | RadialGradient
@@ -441,6 +452,30 @@ class Scene:
             paints=tuple(paint.scaled(factor) for paint in self.paints),
             background_gradient=None if gradient is None else gradient.scaled(factor),
         )
+
+    def window(self, left: int, top: int, width: int, height: int) -> Scene:
+        """The part of the canvas from pixel (``left``, ``top``), ``width`` × ``height``, as a
+        scene of its own: geometry moved so that pixel is the origin, paths and paints kept. Its
+        render is that rectangle of this scene's render."""
+        gradient = self.background_gradient
+        return replace(
+            self,
+            width=width,
+            height=height,
+            points=self.points - np.array([left, top], dtype=np.float64),
+            paints=tuple(paint.shifted(-left, -top) for paint in self.paints),
+            background_gradient=None if gradient is None else gradient.shifted(-left, -top),
+        )
+
+    def path_boxes(self) -> np.ndarray:
+        """(P, 4) float: each path's control-point box (x0, y0, x1, y1), which holds its
+        outline (a cubic lies in the hull of its control points)."""
+        if self.path_count == 0:
+            return np.zeros((0, 4))
+        starts = self.offsets[:-1]
+        low = np.minimum.reduceat(self.points, starts, axis=0)
+        high = np.maximum.reduceat(self.points, starts, axis=0)
+        return np.concatenate([low, high], axis=1)
 
     def render(self, scale: float = 1.0) -> np.ndarray:
         """Rasterize to a float32 (H, W, 3) array in [0, 1] at ``scale`` × the canvas size; no

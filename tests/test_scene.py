@@ -125,3 +125,25 @@ def test_fixed_flags_survive_an_edit_that_leaves_the_path_as_it_was():
     assert edited.fixed is None
     assert list(edited.with_fixed_from(before).fixed_paths()) == [True, False]
     assert edited.with_fixed_from(edited).fixed is None
+
+
+def test_a_window_renders_as_that_rectangle_of_the_whole_render():
+    from samvg.scene import LinearGradient, RadialGradient
+
+    ramp = LinearGradient(((0.0, (1, 0, 0)), (1.0, (0, 0, 1))), 1.0, (4.0, 2.0), (36.0, 18.0))
+    glow = RadialGradient(((0.0, (1, 1, 0)), (1.0, (0, 1, 0))), 1.0, (14.0, 9.0), 6.0)
+    shade = LinearGradient(((0.0, (0, 0, 0)), (1.0, (1, 1, 1))), 0.7, (20.0, 4.0), (30.0, 16.0))
+    paths = [
+        (triangle(1, 1, 9), FlatPaint((0.2, 0.6, 0.3))),
+        (square(8, 3, 12), glow),
+        (square(19, 2, 14), shade),
+    ]
+    scene = Scene.from_paths(40, 20, paths, background_gradient=ramp)
+    whole = scene.render()
+    window = scene.window(5, 3, 24, 13)
+    assert (window.width, window.height) == (24, 13)
+    assert np.allclose(window.render(), whole[3:16, 5:29], atol=1e-5)
+    boxes = scene.path_boxes()
+    for index, (points, _) in enumerate(scene.paths()):
+        assert np.allclose(boxes[index], [*points.min(axis=0), *points.max(axis=0)])
+    assert Scene(4, 4).path_boxes().shape == (0, 4)

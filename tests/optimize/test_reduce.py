@@ -2,7 +2,13 @@
 
 import numpy as np
 
-from samvg.optimize.reduce import reduce_paths, removal_costs
+from samvg.optimize.reduce import (
+    IDLE_COST,
+    _window_cost,
+    reduce_paths,
+    removal_costs,
+    remove_idle_paths,
+)
 from samvg.scene import FlatPaint, Scene
 
 
@@ -47,3 +53,29 @@ def test_reduce_paths_keeps_the_paths_that_matter_in_paint_order():
     assert np.array_equal(reduced.points, scene.subset([1, 2]).points)
     assert np.allclose(reduced.render(), target)
     assert reduce_paths(scene, target, 10)[0].path_count == 4  # under budget: unchanged
+
+
+def test_window_costs_equal_whole_canvas_costs():
+    scene, target = scene_and_target()
+    kept = np.ones(scene.path_count, dtype=bool)
+    windowed = [_window_cost(scene, target, kept, index) for index in range(scene.path_count)]
+    assert np.allclose(windowed, removal_costs(scene, target), rtol=1e-5, atol=1e-9)
+
+
+def test_idle_paths_go_and_visible_ones_stay():
+    scene, target = scene_and_target()
+    same_colour = (square(6, 6, 20), BLUE)  # painted over the blue square in its own colour
+    paths = [*zip(map(scene.path_points, range(4)), scene.paints, strict=True), same_colour]
+    with_idle = Scene.from_paths(64, 64, paths, background=(1.0, 1.0, 1.0))
+    kept, removed = remove_idle_paths(with_idle, target, IDLE_COST)
+    assert removed == 3  # the hidden square, the harmful one and the blue over blue
+    assert np.array_equal(kept.points, scene.subset([1, 2]).points)
+    assert np.allclose(kept.render(), target)
+
+
+def test_of_two_copies_of_a_path_one_stays():
+    scene, target = scene_and_target()
+    doubled = scene.subset([1, 2, 2])  # each copy alone costs nothing: the other paints it
+    kept, removed = remove_idle_paths(doubled, target, IDLE_COST)
+    assert removed == 1 and kept.path_count == 2
+    assert np.allclose(kept.render(), target)
