@@ -86,6 +86,7 @@ def run_one(
         mse=float(np.mean((render - run.target) ** 2)),
         lpips=lpips_distance(lpips, render, run.target),
         seconds=run.seconds,
+        idle_removed=run.result.counts.get("idle_removed", 0),
     )
     if with_vtracer:  # VTracer's default settings on the same working image
         svg = vtracer_default(run.working)
