@@ -4,6 +4,7 @@ import numpy as np
 
 from samvg.optimize.reduce import (
     IDLE_COST,
+    IDLE_SHARE,
     _window_cost,
     reduce_paths,
     removal_costs,
@@ -79,3 +80,19 @@ def test_of_two_copies_of_a_path_one_stays():
     kept, removed = remove_idle_paths(doubled, target, IDLE_COST)
     assert removed == 1 and kept.path_count == 2
     assert np.allclose(kept.render(), target)
+
+
+def test_many_faint_paths_stay_though_each_alone_is_under_the_tolerance():
+    size, grey, faint = 256, (0.5, 0.5, 0.5), (0.6, 0.6, 0.6)
+    dots = [(square(8 * (k % 30) + 4, 8 * (k // 30) + 4, 2), FlatPaint(faint)) for k in range(60)]
+    scene = Scene.from_paths(size, size, dots, background=grey)
+    target = scene.render()
+    kept = np.ones(scene.path_count, dtype=bool)
+    costs = [_window_cost(scene, target, kept, index) for index in range(scene.path_count)]
+    assert 0 < max(costs) < IDLE_COST  # each dot alone is "idle"...
+    assert remove_idle_paths(scene, target, IDLE_COST)[1] == 0  # ...but together they show
+    shifted = np.clip(target + 0.02, 0, 1)  # a scene 4e-4 MSE off: 1 % of that buys a few dots
+    thinned, removed = remove_idle_paths(scene, shifted, IDLE_COST)
+    before = np.mean((scene.render() - shifted) ** 2)
+    assert 0 < removed < 10
+    assert np.mean((thinned.render() - shifted) ** 2) <= before * (1 + IDLE_SHARE) + 1e-12
