@@ -15,11 +15,13 @@ import numpy as np
 
 from samvg.scene import Scene
 
-#: The MSE rise below which a path is idle: a quarter of one pixel's full error on a 512² canvas
-#: (its squared error summed over the canvas, 0.26 at 512²), a change no eye sees.
+#: The mean squared change of the picture below which a path is idle: on a 512² canvas, a
+#: quarter of one pixel turned from black to white (0.26 of squared change summed over the
+#: canvas), a change no eye sees.
 IDLE_COST = 1e-6
-#: The most the MSE may rise from all idle removals together, as a share of the scene's MSE:
-#: many small paths (a field of grass blades) each below ``IDLE_COST`` add up to a visible loss.
+#: The most the picture may change from all idle removals together, as a share of the scene's
+#: MSE: many small paths (a field of grass blades) each below
+#: ``IDLE_COST`` add up to a visible loss.
 IDLE_SHARE = 0.01
 #: Pixels around a path's control-point box that its anti-aliased edge may still touch.
 WINDOW_PAD = 2
@@ -51,16 +53,18 @@ def reduce_paths(scene: Scene, target: np.ndarray, count: int) -> tuple[Scene, i
     return scene, removed
 
 
-def _window_cost(scene: Scene, target: np.ndarray, kept: np.ndarray, index: int) -> float:
-    """The MSE rise when path ``index`` goes from the paths ``kept`` (a bool mask that holds
-    it), measured on the path's window."""
+def _window_renders(
+    scene: Scene, kept: np.ndarray, index: int
+) -> tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None:
+    """Path ``index``'s window (rows, columns) and the renders there of the paths ``kept`` (a
+    bool mask that holds it) with and without it; None when none of it is on the canvas."""
     boxes = scene.path_boxes()
     x0, y0 = np.floor(boxes[index, :2]).astype(int) - WINDOW_PAD
     x1, y1 = np.ceil(boxes[index, 2:]).astype(int) + WINDOW_PAD
     x0, y0 = max(x0, 0), max(y0, 0)
     x1, y1 = min(x1, scene.width), min(y1, scene.height)
     if x1 <= x0 or y1 <= y0:
-        return 0.0  # nothing of it on the canvas
+        return None
     touching = (
         kept
         & (boxes[:, 0] < x1 + 1)
@@ -69,33 +73,55 @@ def _window_cost(scene: Scene, target: np.ndarray, kept: np.ndarray, index: int)
         & (boxes[:, 3] > y0 - 1)
     )
     window = scene.window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
-    inside = target[y0:y1, x0:x1]
     with_path = np.flatnonzero(touching)
     without = with_path[with_path != index]
-    squared = np.sum((window.subset(with_path).render() - inside) ** 2)
-    squared_without = np.sum((window.subset(without).render() - inside) ** 2)
-    return float(squared_without - squared) / target.size
+    area = (slice(int(y0), int(y1)), slice(int(x0), int(x1)))
+    return area, window.subset(with_path).render(), window.subset(without).render()
+
+
+def _window_cost(scene: Scene, target: np.ndarray, kept: np.ndarray, index: int) -> float:
+    """The MSE rise when path ``index`` goes from the paths ``kept`` (a bool mask that holds
+    it), measured on the path's window."""
+    renders = _window_renders(scene, kept, index)
+    if renders is None:
+        return 0.0
+    area, with_path, without = renders
+    inside = target[area]
+    squared = np.sum((with_path - inside) ** 2)
+    return float(np.sum((without - inside) ** 2) - squared) / target.size
+
+
+def _window_change(scene: Scene, kept: np.ndarray, index: int) -> float:
+    """The mean squared change of the picture (over the whole canvas) when path ``index`` goes
+    from the paths ``kept``."""
+    renders = _window_renders(scene, kept, index)
+    if renders is None:
+        return 0.0
+    _, with_path, without = renders
+    return float(np.sum((with_path - without) ** 2)) / (scene.width * scene.height * 3)
 
 
 def remove_idle_paths(
     scene: Scene, target: np.ndarray, tolerance: float, share: float = IDLE_SHARE
 ) -> tuple[Scene, int]:
-    """``scene`` without the paths whose removal raises the MSE by less than ``tolerance``, as
-    long as the removals together raise it by at most ``share`` of the scene's MSE; returns it
-    and how many went. Paths go one at a time, cheapest first, each measured again against the
-    scene left by the removals before it (two copies of one path each cost nothing alone; the
-    second then costs its full worth and stays)."""
+    """``scene`` without its idle paths, those whose removal changes the picture by less than
+    ``tolerance`` (mean squared change), as long as the changes together stay within ``share``
+    of the scene's MSE against ``target``; returns it and how many went. Paths go one at a
+    time, smallest change first, each measured again against the scene left by the removals
+    before it (two copies of one path each change nothing alone; the second then changes the
+    picture and stays). The change, not the error: a path that raises the MSE may still be what
+    the LPIPS term of the fit put there."""
     kept = np.ones(scene.path_count, dtype=bool)
-    costs = np.array([_window_cost(scene, target, kept, i) for i in range(scene.path_count)])
-    if not np.any(costs < tolerance):
+    changes = np.array([_window_change(scene, kept, i) for i in range(scene.path_count)])
+    if not np.any(changes < tolerance):
         return scene, 0
     budget = share * float(np.mean((scene.render() - target) ** 2))
-    for index in np.argsort(costs, kind="stable"):
-        if costs[index] >= tolerance:
+    for index in np.argsort(changes, kind="stable"):
+        if changes[index] >= tolerance:
             break
-        cost = _window_cost(scene, target, kept, int(index))
-        if cost < tolerance and cost <= budget:
+        change = _window_change(scene, kept, int(index))
+        if change < tolerance and change <= budget:
             kept[index] = False
-            budget -= cost
+            budget -= change
     removed = int(np.count_nonzero(~kept))
     return (scene.subset(np.flatnonzero(kept)) if removed else scene), removed
