@@ -86,6 +86,11 @@ def row_for(
     return row
 
 
+def saved_svgs(folder: Path, image_id: str) -> list[Path]:
+    """An image's saved SVGs: ``<id>.svg`` (bench_geometry.py's) and ``<id>.<tag>.svg``."""
+    return sorted(folder.glob(f"{image_id}.svg")) + sorted(folder.glob(f"{image_id}.*.svg"))
+
+
 def row_from_svgs(entry: dict[str, str], folder: Path) -> list[Image.Image]:
     """Target | the image's first saved SVG | VTracer's default | its other saved SVGs, with
     paths, MSE and bytes."""
@@ -95,12 +100,12 @@ def row_from_svgs(entry: dict[str, str], folder: Path) -> list[Image.Image]:
     target = to_float_rgb(working)
     height, width = target.shape[:2]
     row = [cell(target, entry["id"][:36])]
-    for path in sorted(folder.glob(f"{entry['id']}.*.svg")):
+    for path in saved_svgs(folder, entry["id"]):
         svg = path.read_text()
         image = VectorImage.from_svg(svg)
         picture = render_at_working_size(image, scale, target.shape)
         error = float(np.mean((picture - target) ** 2))
-        tag = path.name[len(entry["id"]) + 1 : -4]
+        tag = path.name[len(entry["id"]) + 1 : -4] or "samvg"
         row.append(cell(picture, f"{tag}: {len(image.paths)}p {error * 1e3:.2f}e-3 "
                                  f"{len(svg.encode()) / 1e3:.1f}kB"))  # fmt: skip
     svg = vtracer_default(working)
@@ -135,7 +140,7 @@ def main() -> None:
     else:
         entries = bench_entries(arguments.per_category, wanted)
     if arguments.svg_dir is not None:
-        entries = [e for e in entries if any(arguments.svg_dir.glob(f"{e['id']}.*.svg"))]
+        entries = [e for e in entries if saved_svgs(arguments.svg_dir, e["id"])]
         rows = [row_from_svgs(entry, arguments.svg_dir) for entry in entries]
     else:
         rows = [row_for(entry, config, arguments.budget) for entry in entries]
