@@ -5,8 +5,8 @@ reduced scene again), and remove the idle paths of any scene, those whose remova
 picture by less than a tolerance (a path painted over the same colour, a sliver under a
 neighbour's edge).
 
-A path's removal cost is measured on its own window (its control-point box, padded for the
-anti-aliased edge): no pixel outside it changes, so the cost is the whole image's, at a cost
+An idle path's change is measured on its own window (its control-point box, padded for the
+anti-aliased edge): no pixel outside it changes, so the change is the whole image's, at a cost
 in time that follows the path's size rather than the canvas's."""
 
 from __future__ import annotations
@@ -53,18 +53,16 @@ def reduce_paths(scene: Scene, target: np.ndarray, count: int) -> tuple[Scene, i
     return scene, removed
 
 
-def _window_renders(
-    scene: Scene, kept: np.ndarray, index: int
-) -> tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None:
-    """Path ``index``'s window (rows, columns) and the renders there of the paths ``kept`` (a
-    bool mask that holds it) with and without it; None when none of it is on the canvas."""
-    boxes = scene.path_boxes()
+def _window_change(scene: Scene, boxes: np.ndarray, kept: np.ndarray, index: int) -> float:
+    """The mean squared change of the picture (over the whole canvas) when path ``index`` goes
+    from the paths ``kept`` (a bool mask that holds it), rendered on the path's window alone
+    from the kept paths whose ``boxes`` (`Scene.path_boxes`) reach into it."""
     x0, y0 = np.floor(boxes[index, :2]).astype(int) - WINDOW_PAD
     x1, y1 = np.ceil(boxes[index, 2:]).astype(int) + WINDOW_PAD
     x0, y0 = max(x0, 0), max(y0, 0)
     x1, y1 = min(x1, scene.width), min(y1, scene.height)
     if x1 <= x0 or y1 <= y0:
-        return None
+        return 0.0  # nothing of it on the canvas
     touching = (
         kept
         & (boxes[:, 0] < x1 + 1)
@@ -72,33 +70,11 @@ def _window_renders(
         & (boxes[:, 1] < y1 + 1)
         & (boxes[:, 3] > y0 - 1)
     )
-    window = scene.window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
     with_path = np.flatnonzero(touching)
-    without = with_path[with_path != index]
-    area = (slice(int(y0), int(y1)), slice(int(x0), int(x1)))
-    return area, window.subset(with_path).render(), window.subset(without).render()
-
-
-def _window_cost(scene: Scene, target: np.ndarray, kept: np.ndarray, index: int) -> float:
-    """The MSE rise when path ``index`` goes from the paths ``kept`` (a bool mask that holds
-    it), measured on the path's window."""
-    renders = _window_renders(scene, kept, index)
-    if renders is None:
-        return 0.0
-    area, with_path, without = renders
-    inside = target[area]
-    squared = np.sum((with_path - inside) ** 2)
-    return float(np.sum((without - inside) ** 2) - squared) / target.size
-
-
-def _window_change(scene: Scene, kept: np.ndarray, index: int) -> float:
-    """The mean squared change of the picture (over the whole canvas) when path ``index`` goes
-    from the paths ``kept``."""
-    renders = _window_renders(scene, kept, index)
-    if renders is None:
-        return 0.0
-    _, with_path, without = renders
-    return float(np.sum((with_path - without) ** 2)) / (scene.width * scene.height * 3)
+    window = scene.subset(with_path).window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
+    without = window.subset(np.flatnonzero(with_path != index))
+    squared = np.sum((window.render() - without.render()) ** 2)
+    return float(squared) / (scene.width * scene.height * 3)
 
 
 def remove_idle_paths(
@@ -112,14 +88,15 @@ def remove_idle_paths(
     picture and stays). The change, not the error: a path that raises the MSE may still be what
     the LPIPS term of the fit put there."""
     kept = np.ones(scene.path_count, dtype=bool)
-    changes = np.array([_window_change(scene, kept, i) for i in range(scene.path_count)])
+    boxes = scene.path_boxes()
+    changes = np.array([_window_change(scene, boxes, kept, i) for i in range(scene.path_count)])
     if not np.any(changes < tolerance):
         return scene, 0
     budget = share * float(np.mean((scene.render() - target) ** 2))
     for index in np.argsort(changes, kind="stable"):
         if changes[index] >= tolerance:
             break
-        change = _window_change(scene, kept, int(index))
+        change = _window_change(scene, boxes, kept, int(index))
         if change < tolerance and change <= budget:
             kept[index] = False
             budget -= change
