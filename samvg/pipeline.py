@@ -29,6 +29,7 @@ from samvg.finish import (
     simplify_paths,
 )
 from samvg.finish.outline import polygon_areas
+from samvg.finish.whole_pixels import ROUNDING_SHARE, whole_pixel_paths
 from samvg.imaging import alpha_channel, resize_longest, to_float_rgb, to_rgb_uint8
 from samvg.io import read_image_with_alpha
 from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
@@ -272,7 +273,9 @@ def _run_stages(
         scene = _finish_pass(scene, config, inputs, result, report)
     if budget is not None:
         scene = _meet_budget(scene, inputs, budget, result)
-    _finish(scene, inputs.target, result, config.finish.finish_pass, _path_limit(config))
+    simple = config.finish.finish_pass
+    whole = simple and config.finish.whole_pixels
+    _finish(scene, inputs.target, result, simple, _path_limit(config), whole)
 
 
 def _finish_pass(
@@ -494,18 +497,28 @@ def _finish(
     result: PipelineResult,
     simple: bool = False,
     limit: int | None = None,
+    whole_pixels: bool = False,
 ) -> None:
     """The result's scene, SVG and MSE (of the SVG as written, at the working size). A path that
     rounding to the SVG's precision makes cross itself is repaired (``simple``); parts that
     repair splits off beyond ``limit`` paths go, smallest first, so a budget or a path limit
-    still holds."""
+    still holds. With ``whole_pixels``, paths that rounding to whole pixels changes by less than
+    ``IDLE_COST`` are saved so (`whole_pixel_paths`, 2 % of the MSE in all)."""
     result.scene = scene
     output = scene.in_input_pixels()
     saved = _largest(simple_when_saved(output), limit) if simple else output
-    result.image = VectorImage.from_scene(saved)
     scale = scene.frame.scale if scene.frame is not None else 1.0
     written = saved.on_canvas(scene.width, scene.height, scale)  # the SVG at the working size
     result.mse = float(np.mean((written.render() - target) ** 2))
+    if whole_pixels:
+        with _timed(result, "finish"):
+            working = (scene.width, scene.height, scale)
+            saved, rounded = whole_pixel_paths(saved, working, ROUNDING_SHARE * result.mse)
+            result.counts["whole_pixel_paths"] = rounded
+            if rounded:
+                written = saved.on_canvas(*working)
+                result.mse = float(np.mean((written.render() - target) ** 2))
+    result.image = VectorImage.from_scene(saved)
     result.counts["paths"] = result.image.scene.path_count
     result.counts["gradient_fills"] = sum(
         not isinstance(paint, FlatPaint) for paint in result.image.scene.paints

@@ -53,12 +53,23 @@ def reduce_paths(scene: Scene, target: np.ndarray, count: int) -> tuple[Scene, i
     return scene, removed
 
 
-def _window_change(scene: Scene, boxes: np.ndarray, kept: np.ndarray, index: int) -> float:
+def window_change(
+    scene: Scene,
+    boxes: np.ndarray,
+    kept: np.ndarray,
+    index: int,
+    replacement: np.ndarray | None = None,
+) -> float:
     """The mean squared change of the picture (over the whole canvas) when path ``index`` goes
-    from the paths ``kept`` (a bool mask that holds it), rendered on the path's window alone
-    from the kept paths whose ``boxes`` (`Scene.path_boxes`) reach into it."""
-    x0, y0 = np.floor(boxes[index, :2]).astype(int) - WINDOW_PAD
-    x1, y1 = np.ceil(boxes[index, 2:]).astype(int) + WINDOW_PAD
+    from the paths ``kept`` (a bool mask that holds it), or with ``replacement`` (its control
+    points, the same count) when it is redrawn there: rendered on the path's window alone (both
+    outlines' boxes, padded) from the kept paths whose ``boxes`` (`Scene.path_boxes`) reach
+    into it."""
+    low, high = boxes[index, :2], boxes[index, 2:]
+    if replacement is not None:
+        low, high = np.minimum(low, replacement.min(axis=0)), np.maximum(high, replacement.max(axis=0))
+    x0, y0 = np.floor(low).astype(int) - WINDOW_PAD
+    x1, y1 = np.ceil(high).astype(int) + WINDOW_PAD
     x0, y0 = max(x0, 0), max(y0, 0)
     x1, y1 = min(x1, scene.width), min(y1, scene.height)
     if x1 <= x0 or y1 <= y0:
@@ -70,10 +81,17 @@ def _window_change(scene: Scene, boxes: np.ndarray, kept: np.ndarray, index: int
         & (boxes[:, 1] < y1 + 1)
         & (boxes[:, 3] > y0 - 1)
     )
+    touching[index] = True
     with_path = np.flatnonzero(touching)
     window = scene.subset(with_path).window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
-    without = window.subset(np.flatnonzero(with_path != index))
-    squared = np.sum((window.render() - without.render()) ** 2)
+    if replacement is None:
+        changed = window.subset(np.flatnonzero(with_path != index))
+    else:
+        local = int(np.searchsorted(with_path, index))
+        points = window.points.copy()
+        points[window.offsets[local] : window.offsets[local + 1]] = replacement - [x0, y0]
+        changed = window.with_geometry(points)
+    squared = np.sum((window.render() - changed.render()) ** 2)
     return float(squared) / (scene.width * scene.height * 3)
 
 
@@ -89,14 +107,14 @@ def remove_idle_paths(
     the LPIPS term of the fit put there."""
     kept = np.ones(scene.path_count, dtype=bool)
     boxes = scene.path_boxes()
-    changes = np.array([_window_change(scene, boxes, kept, i) for i in range(scene.path_count)])
+    changes = np.array([window_change(scene, boxes, kept, i) for i in range(scene.path_count)])
     if not np.any(changes < tolerance):
         return scene, 0
     budget = share * float(np.mean((scene.render() - target) ** 2))
     for index in np.argsort(changes, kind="stable"):
         if changes[index] >= tolerance:
             break
-        change = _window_change(scene, boxes, kept, int(index))
+        change = window_change(scene, boxes, kept, int(index))
         if change < tolerance and change <= budget:
             kept[index] = False
             budget -= change

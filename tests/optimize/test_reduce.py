@@ -5,7 +5,7 @@ import numpy as np
 from samvg.optimize.reduce import (
     IDLE_COST,
     IDLE_SHARE,
-    _window_change,
+    window_change,
     reduce_paths,
     removal_costs,
     remove_idle_paths,
@@ -56,10 +56,10 @@ def test_reduce_paths_keeps_the_paths_that_matter_in_paint_order():
     assert reduce_paths(scene, target, 10)[0].path_count == 4  # under budget: unchanged
 
 
-def test_window_changes_equal_whole_canvas_changes():
+def testwindow_changes_equal_whole_canvas_changes():
     scene, _ = scene_and_target()
     kept, boxes, picture = np.ones(scene.path_count, dtype=bool), scene.path_boxes(), scene.render()
-    windowed = [_window_change(scene, boxes, kept, index) for index in range(scene.path_count)]
+    windowed = [window_change(scene, boxes, kept, index) for index in range(scene.path_count)]
     whole = [
         np.mean((picture - scene.subset(np.flatnonzero(np.arange(4) != index)).render()) ** 2)
         for index in range(scene.path_count)
@@ -100,7 +100,7 @@ def test_many_faint_paths_stay_though_each_alone_is_under_the_tolerance():
     scene = Scene.from_paths(size, size, dots, background=grey)
     picture = scene.render()
     kept, boxes = np.ones(scene.path_count, dtype=bool), scene.path_boxes()
-    changes = [_window_change(scene, boxes, kept, index) for index in range(scene.path_count)]
+    changes = [window_change(scene, boxes, kept, index) for index in range(scene.path_count)]
     assert min(changes) > 0 and max(changes) < IDLE_COST  # each dot alone is "idle"...
     assert remove_idle_paths(scene, picture, IDLE_COST)[1] == 0  # ...but together they show
     target = np.clip(picture + 0.02, 0, 1)  # a scene 4e-4 MSE off: 1 % of that buys a few dots
