@@ -67,7 +67,8 @@ def window_change(
     into it."""
     low, high = boxes[index, :2], boxes[index, 2:]
     if replacement is not None:
-        low, high = np.minimum(low, replacement.min(axis=0)), np.maximum(high, replacement.max(axis=0))
+        low = np.minimum(low, replacement.min(axis=0))
+        high = np.maximum(high, replacement.max(axis=0))
     x0, y0 = np.floor(low).astype(int) - WINDOW_PAD
     x1, y1 = np.ceil(high).astype(int) + WINDOW_PAD
     x0, y0 = max(x0, 0), max(y0, 0)

@@ -5,10 +5,10 @@ import numpy as np
 from samvg.optimize.reduce import (
     IDLE_COST,
     IDLE_SHARE,
-    window_change,
     reduce_paths,
     removal_costs,
     remove_idle_paths,
+    window_change,
 )
 from samvg.scene import FlatPaint, Scene
 
