@@ -210,6 +210,8 @@ def test_default_output_is_opaque_bounded_and_simple(emoji, sam_checkpoint):
     assert len(crossing_paths(scene)) == 0
     margin = 0.05 * 96
     assert scene.points.min() >= -margin and scene.points.max() <= 96 + margin
+    whole = [np.array_equal(points, np.rint(points)) for points, _ in scene.paths()]
+    assert sum(whole) >= result.counts["whole_pixel_paths"] >= 1  # saved without decimals
     paper = samvg.run(emoji, Config.paper(checkpoint=str(sam_checkpoint), **QUICK))
     assert all(k == 5 for k in paper.image.scene.segment_counts())
 

@@ -2,7 +2,8 @@
 
 Bounded control points (``bounds``), simple paths (``simplicity``), no hidden paths
 (``hidden``, which also turns a path over the whole canvas into the background), merged paths
-of near-equal colour (``merge``) and an optional palette (``palette``). They share one
+of near-equal colour (``merge``), an optional palette (``palette``) and, when the scene is
+saved, paths in whole pixels where that changes nothing visible (``whole_pixels``). They share one
 flattener (``flatten``), the painted area of a path as shapely geometry (``outline``),
 outlines redrawn from the cubics they were cut from (``trim``) or fitted afresh (``refit``),
 cubic-segment operations (``cubics``) and per-path scene edits (``edits``).

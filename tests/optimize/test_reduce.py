@@ -56,7 +56,7 @@ def test_reduce_paths_keeps_the_paths_that_matter_in_paint_order():
     assert reduce_paths(scene, target, 10)[0].path_count == 4  # under budget: unchanged
 
 
-def testwindow_changes_equal_whole_canvas_changes():
+def test_window_changes_equal_whole_canvas_changes():
     scene, _ = scene_and_target()
     kept, boxes, picture = np.ones(scene.path_count, dtype=bool), scene.path_boxes(), scene.render()
     windowed = [window_change(scene, boxes, kept, index) for index in range(scene.path_count)]
@@ -108,3 +108,15 @@ def test_many_faint_paths_stay_though_each_alone_is_under_the_tolerance():
     budget = IDLE_SHARE * np.mean((picture - target) ** 2)
     assert 0 < removed <= budget / min(changes)
     assert np.mean((thinned.render() - picture) ** 2) <= budget * 1.0001
+
+
+def test_window_change_of_a_redrawn_path_equals_the_whole_canvas_change():
+    scene, _ = scene_and_target()
+    kept, boxes, picture = np.ones(scene.path_count, dtype=bool), scene.path_boxes(), scene.render()
+    for index in range(scene.path_count):
+        moved = scene.path_points(index) + [1.4, -0.7]
+        points = scene.points.copy()
+        points[scene.offsets[index] : scene.offsets[index + 1]] = moved
+        whole = np.mean((scene.with_geometry(points).render() - picture) ** 2)
+        windowed = window_change(scene, boxes, kept, index, moved)
+        assert np.isclose(windowed, whole, rtol=1e-5, atol=1e-9)
