@@ -88,6 +88,7 @@ def run_one(
         seconds=run.seconds,
         idle_removed=run.result.counts.get("idle_removed", 0),
         whole_pixel_paths=run.result.counts.get("whole_pixel_paths", 0),
+        gradients_flattened=run.result.counts.get("gradients_flattened", 0),
     )
     if with_vtracer:  # VTracer's default settings on the same working image
         svg = vtracer_default(run.working)

@@ -37,7 +37,12 @@ from samvg.missing import MissingSettings
 from samvg.missing.stage import BUDGET_POOL, MAX_AUTO_ROUNDS, add_missing_rounds
 from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import margin_box
-from samvg.optimize.reduce import IDLE_COST, reduce_paths, remove_idle_paths
+from samvg.optimize.reduce import (
+    IDLE_COST,
+    flatten_idle_gradients,
+    reduce_paths,
+    remove_idle_paths,
+)
 from samvg.optimize.reshape import reshape_scene
 from samvg.render.threads import using_render_threads
 from samvg.sam import SPECS
@@ -296,6 +301,10 @@ def _finish_pass(
         counts = dict(finished.counts)
         if config.finish.remove_idle:
             scene, counts["idle_removed"] = remove_idle_paths(scene, inputs.target, IDLE_COST)
+        if config.finish.flatten_idle_gradients:
+            scene, counts["gradients_flattened"] = flatten_idle_gradients(
+                scene, inputs.target, IDLE_COST
+            )
         for name, count in counts.items():
             result.counts[name] = result.counts.get(name, 0) + count
         result.notes.append(_finish_note(counts))
@@ -473,7 +482,7 @@ def _finish_note(counts: dict[str, int]) -> str:
         f"({counts.get('simple_split', 0)} parts split off), "
         f"{counts.get('bounds_clipped', 0)} clipped to the canvas, "
         f"{counts.get('hidden_removed', 0)} hidden and {counts.get('idle_removed', 0)} idle "
-        "paths removed, "
+        f"paths removed, {counts.get('gradients_flattened', 0)} idle gradients made flat, "
         f"{counts.get('merged', 0)} merged"
         + (", the path over the whole canvas made the background"
            if counts.get("background_from_path") else "")

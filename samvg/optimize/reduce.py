@@ -3,7 +3,8 @@ whose removal raises the error least, a batch at a time and measuring again afte
 (the top-down step of Optimize & Reduce, Hirschorn et al., AAAI 2024; the caller fits the
 reduced scene again), and remove the idle paths of any scene, those whose removal changes the
 picture by less than a tolerance (a path painted over the same colour, a sliver under a
-neighbour's edge).
+neighbour's edge); likewise make idle gradient fills flat (a gradient mostly covered by the
+paths above it, or one that barely changes over what shows).
 
 An idle path's change is measured on its own window (its control-point box, padded for the
 anti-aliased edge): no pixel outside it changes, so the change is the whole image's, at a cost
@@ -11,9 +12,11 @@ in time that follows the path's size rather than the canvas's."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
-from samvg.scene import Scene
+from samvg.scene import FlatPaint, Paint, Scene
 
 #: The mean squared change of the picture below which a path is idle: on a 512² canvas, a
 #: quarter of one pixel turned from black to white (0.26 of squared change summed over the
@@ -53,6 +56,35 @@ def reduce_paths(scene: Scene, target: np.ndarray, count: int) -> tuple[Scene, i
     return scene, removed
 
 
+def _path_window(
+    scene: Scene, boxes: np.ndarray, kept: np.ndarray, index: int, extra: np.ndarray | None
+) -> tuple[Scene, int, np.ndarray] | None:
+    """Path ``index``'s window (its box, with the ``extra`` points', padded) as a scene of the
+    kept paths whose ``boxes`` reach into it, the path's index there and the window's origin;
+    None when none of it is on the canvas."""
+    low, high = boxes[index, :2], boxes[index, 2:]
+    if extra is not None:
+        low = np.minimum(low, extra.min(axis=0))
+        high = np.maximum(high, extra.max(axis=0))
+    x0, y0 = np.floor(low).astype(int) - WINDOW_PAD
+    x1, y1 = np.ceil(high).astype(int) + WINDOW_PAD
+    x0, y0 = max(x0, 0), max(y0, 0)
+    x1, y1 = min(x1, scene.width), min(y1, scene.height)
+    if x1 <= x0 or y1 <= y0:
+        return None
+    touching = (
+        kept
+        & (boxes[:, 0] < x1 + 1)
+        & (boxes[:, 2] > x0 - 1)
+        & (boxes[:, 1] < y1 + 1)
+        & (boxes[:, 3] > y0 - 1)
+    )
+    touching[index] = True
+    with_path = np.flatnonzero(touching)
+    window = scene.subset(with_path).window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
+    return window, int(np.searchsorted(with_path, index)), np.array([x0, y0], dtype=np.float64)
+
+
 def window_change(
     scene: Scene,
     boxes: np.ndarray,
@@ -65,35 +97,103 @@ def window_change(
     points, the same count) when it is redrawn there: rendered on the path's window alone (both
     outlines' boxes, padded) from the kept paths whose ``boxes`` (`Scene.path_boxes`) reach
     into it."""
-    low, high = boxes[index, :2], boxes[index, 2:]
-    if replacement is not None:
-        low = np.minimum(low, replacement.min(axis=0))
-        high = np.maximum(high, replacement.max(axis=0))
-    x0, y0 = np.floor(low).astype(int) - WINDOW_PAD
-    x1, y1 = np.ceil(high).astype(int) + WINDOW_PAD
-    x0, y0 = max(x0, 0), max(y0, 0)
-    x1, y1 = min(x1, scene.width), min(y1, scene.height)
-    if x1 <= x0 or y1 <= y0:
+    found = _path_window(scene, boxes, kept, index, replacement)
+    if found is None:
         return 0.0  # nothing of it on the canvas
-    touching = (
-        kept
-        & (boxes[:, 0] < x1 + 1)
-        & (boxes[:, 2] > x0 - 1)
-        & (boxes[:, 1] < y1 + 1)
-        & (boxes[:, 3] > y0 - 1)
-    )
-    touching[index] = True
-    with_path = np.flatnonzero(touching)
-    window = scene.subset(with_path).window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
+    window, local, origin = found
     if replacement is None:
-        changed = window.subset(np.flatnonzero(with_path != index))
+        changed = window.subset(np.flatnonzero(np.arange(window.path_count) != local))
     else:
-        local = int(np.searchsorted(with_path, index))
         points = window.points.copy()
-        points[window.offsets[local] : window.offsets[local + 1]] = replacement - [x0, y0]
+        points[window.offsets[local] : window.offsets[local + 1]] = replacement - origin
         changed = window.with_geometry(points)
     squared = np.sum((window.render() - changed.render()) ** 2)
     return float(squared) / (scene.width * scene.height * 3)
+
+
+def _with_paint(scene: Scene, index: int, paint: Paint) -> Scene:
+    paints = list(scene.paints)
+    paints[index] = paint
+    return replace(scene, paints=tuple(paints))
+
+
+def _least_squares_colour(
+    picture: np.ndarray, base: np.ndarray, reach: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """The colour c in [0, 1]³ for which ``base + reach * c`` is nearest ``picture`` (a render
+    affine in one fill's colour: black gives ``base``, white ``base + reach``), and the squared
+    distance left, summed."""
+    weight = np.sum(reach * reach, axis=(0, 1))
+    fitted = np.sum(reach * (picture - base), axis=(0, 1)) / np.maximum(weight, 1e-12)
+    colour = np.clip(fitted, 0.0, 1.0)
+    return colour, float(np.sum((base + reach * colour - picture) ** 2))
+
+
+def _flat_stand_in(scene: Scene, index: int) -> tuple[FlatPaint, float]:
+    """The flat fill that changes the render least in place of path ``index``'s gradient, and
+    the squared change it makes, summed."""
+    opacity = scene.paints[index].rgba[3]
+    base = _with_paint(scene, index, FlatPaint((0.0, 0.0, 0.0, opacity))).render()
+    white = _with_paint(scene, index, FlatPaint((1.0, 1.0, 1.0, opacity))).render()
+    colour, squared = _least_squares_colour(scene.render(), base, white - base)
+    return FlatPaint((*colour.tolist(), opacity)), squared
+
+
+def _flat_background(scene: Scene) -> tuple[tuple[float, float, float], float]:
+    """The flat background that changes the render least in place of the background gradient,
+    and the squared change it makes, summed."""
+    base = scene.with_background((0.0, 0.0, 0.0)).render()
+    white = scene.with_background((1.0, 1.0, 1.0)).render()
+    colour, squared = _least_squares_colour(scene.render(), base, white - base)
+    return (float(colour[0]), float(colour[1]), float(colour[2])), squared
+
+
+def _gradient_change(
+    scene: Scene, boxes: np.ndarray, kept: np.ndarray, index: int
+) -> tuple[FlatPaint, float]:
+    """Path ``index``'s best flat stand-in and the mean squared change of the picture it makes,
+    measured on the path's window."""
+    found = _path_window(scene, boxes, kept, index, None)
+    if found is None:
+        return FlatPaint(scene.paints[index].rgba), 0.0
+    window, local, _ = found
+    paint, squared = _flat_stand_in(window, local)
+    return paint, squared / (scene.width * scene.height * 3)
+
+
+def flatten_idle_gradients(
+    scene: Scene, target: np.ndarray, tolerance: float, share: float = IDLE_SHARE
+) -> tuple[Scene, int]:
+    """``scene`` with its idle gradients flat: a gradient fill (or background) whose best flat
+    colour changes the picture by less than ``tolerance`` (mean squared change) takes that
+    colour, smallest change first, each measured again against the fills flattened before it,
+    the changes together within ``share`` of the scene's MSE against ``target``; returns it and
+    how many fills went flat. A gradient costs some 200 bytes of SVG; a flat fill, seven."""
+    gradients = [i for i, paint in enumerate(scene.paints) if not isinstance(paint, FlatPaint)]
+    if not gradients and scene.background_gradient is None:
+        return scene, 0
+    budget = share * float(np.mean((scene.render() - target) ** 2))
+    kept = np.ones(scene.path_count, dtype=bool)
+    boxes = scene.path_boxes()
+    changes = [_gradient_change(scene, boxes, kept, index)[1] for index in gradients]
+    flattened = 0
+    for order in np.argsort(changes, kind="stable"):
+        if changes[order] >= tolerance:
+            break
+        index = gradients[int(order)]
+        paint, change = _gradient_change(scene, boxes, kept, index)
+        if change < tolerance and change <= budget:
+            scene, budget, flattened = (
+                _with_paint(scene, index, paint),
+                budget - change,
+                flattened + 1,
+            )
+    if scene.background_gradient is not None:
+        colour, squared = _flat_background(scene)
+        change = squared / (scene.width * scene.height * 3)
+        if change < tolerance and change <= budget:
+            scene, flattened = scene.with_background(colour), flattened + 1
+    return scene, flattened
 
 
 def remove_idle_paths(

@@ -1,16 +1,19 @@
-"""Reducing a scene to a path budget by removal cost."""
+"""Reducing a scene to a path budget by removal cost; idle paths and gradients."""
+
+from dataclasses import replace
 
 import numpy as np
 
 from samvg.optimize.reduce import (
     IDLE_COST,
     IDLE_SHARE,
+    flatten_idle_gradients,
     reduce_paths,
     removal_costs,
     remove_idle_paths,
     window_change,
 )
-from samvg.scene import FlatPaint, Scene
+from samvg.scene import FlatPaint, LinearGradient, RadialGradient, Scene
 
 
 def square(left: float, top: float, side: float) -> np.ndarray:
@@ -120,3 +123,44 @@ def test_window_change_of_a_redrawn_path_equals_the_whole_canvas_change():
         whole = np.mean((scene.with_geometry(points).render() - picture) ** 2)
         windowed = window_change(scene, boxes, kept, index, moved)
         assert np.isclose(windowed, whole, rtol=1e-5, atol=1e-9)
+
+
+def gradient_scene() -> Scene:
+    """Over a strong linear background gradient: a gradient square whose stops barely differ, a
+    strong radial gradient, and a wide opaque band that covers all but a strip of the
+    background."""
+    faint = RadialGradient(((0.0, (0.50, 0.30, 0.20)), (1.0, (0.51, 0.31, 0.21))), 1.0, (20, 20), 9)
+    strong = RadialGradient(((0.0, (1.0, 1.0, 0.0)), (1.0, (0.0, 0.0, 1.0))), 1.0, (46, 20), 9)
+    band = FlatPaint((0.2, 0.6, 0.3))
+    paths = [(square(-2, 32, 68), band), (square(10, 10, 20), faint), (square(36, 10, 20), strong)]
+    background = LinearGradient(
+        ((0.0, (0.0, 0.0, 0.0)), (1.0, (1.0, 1.0, 1.0))), 1.0, (0, 0), (64, 0)
+    )
+    scene = Scene.from_paths(64, 64, paths, background=(0.5, 0.5, 0.5))
+    return replace(scene, background_gradient=background)
+
+
+def test_a_gradient_that_barely_changes_goes_flat_and_a_strong_one_stays():
+    scene = gradient_scene()
+    flat, count = flatten_idle_gradients(scene, scene.render() + 0.01, IDLE_COST, share=1.0)
+    assert count == 1
+    assert isinstance(flat.paints[1], FlatPaint) and isinstance(flat.paints[2], RadialGradient)
+    assert np.allclose(flat.paints[1].rgba[:3], (0.505, 0.305, 0.205), atol=0.003)  # the mean
+    assert flat.background_gradient is not None  # black to white across what shows
+    assert np.mean((flat.render() - scene.render()) ** 2) < IDLE_COST
+
+
+def test_a_background_gradient_that_does_not_show_goes_flat():
+    scene = gradient_scene()
+    covered = Scene.from_paths(64, 64, [(square(-2, -2, 68), FlatPaint((0.2, 0.6, 0.3)))])
+    covered = replace(covered, background_gradient=scene.background_gradient)
+    flat, count = flatten_idle_gradients(covered, covered.render() + 0.01, IDLE_COST)
+    assert count == 1 and flat.background_gradient is None
+    assert np.array_equal(flat.render(), covered.render())
+
+
+def test_no_gradient_goes_flat_beyond_the_budget():
+    scene = gradient_scene()
+    picture = scene.render()
+    assert flatten_idle_gradients(scene, picture, IDLE_COST)[1] == 0  # the scene has no error
+    assert flatten_idle_gradients(scene, picture + 0.01, IDLE_COST)[1] == 1
