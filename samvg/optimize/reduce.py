@@ -183,11 +183,9 @@ def flatten_idle_gradients(
         index = gradients[int(order)]
         paint, change = _gradient_change(scene, boxes, kept, index)
         if change < tolerance and change <= budget:
-            scene, budget, flattened = (
-                _with_paint(scene, index, paint),
-                budget - change,
-                flattened + 1,
-            )
+            scene = _with_paint(scene, index, paint)
+            budget -= change
+            flattened += 1
     if scene.background_gradient is not None:
         colour, squared = _flat_background(scene)
         change = squared / (scene.width * scene.height * 3)
