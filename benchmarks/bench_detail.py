@@ -29,7 +29,7 @@ from bench_images import REPO, bench_entries, run_samvg, setting_value, working_
 from PIL import Image
 
 import samvg
-from samvg.baselines import render_svg, run_baseline
+from samvg.baselines import count_shapes, render_svg, run_baseline
 from samvg.baselines.vtracer_baseline import trace_once
 from samvg.imaging import to_float_rgb
 from samvg.io import atomic_write_text
@@ -67,6 +67,7 @@ def samvg_record(
         atomic_write_text(keep_svg / f"{entry['id']}.{tag}.svg", svg)
     return {
         "paths": run.result.counts.get("paths", 0),
+        "shapes": count_shapes(svg),
         "gradient_fills": run.result.counts.get("gradient_fills", 0),
         "svg_bytes": len(svg.encode()),
         "seconds": run.seconds,
@@ -85,6 +86,7 @@ def baseline_record(entry: dict[str, str], method: str, paths: int, lpips: Any) 
     height, width = target.shape[:2]
     return {
         "paths": svg.count("<path"),
+        "shapes": count_shapes(svg),
         "svg_bytes": len(svg.encode()),
         "seconds": seconds,
         **measured(render_svg(svg, width, height), target, lpips),
@@ -102,6 +104,7 @@ def vtracer_record(entry: dict[str, str], setting: tuple[int, int, int], lpips: 
     height, width = target.shape[:2]
     return {
         "paths": svg.count("<path"),
+        "shapes": count_shapes(svg),
         "svg_bytes": len(svg.encode()),
         "seconds": seconds,
         **measured(render_svg(svg, width, height), target, lpips),

@@ -1,5 +1,5 @@
 """The vtracer baseline: VTracer (PyPI ``vtracer``) with its settings searched per image so that
-its path count comes as close as possible to a target count.
+its path count comes as close as possible to a target count without exceeding it.
 
 VTracer's paths are compound (holes as extra subpaths) and carry ``translate`` transforms, which
 :class:`samvg.VectorImage` cannot hold, so its SVG is kept as text and rendered with resvg.
@@ -60,6 +60,11 @@ class TracedSvg:
             + 3 * len(re.findall(r'\bfill="#', self.svg))
         )
 
+    @property
+    def shape_count(self) -> int:
+        """Number of closed shapes: subpaths (one per move-to) over all ``<path>`` elements."""
+        return count_shapes(self.svg)
+
     def to_svg(self) -> str:
         return self.svg
 
@@ -70,6 +75,13 @@ class TracedSvg:
     def render(self) -> np.ndarray:
         """Rasterize with resvg over white: float32 (H, W, 3) in [0, 1]."""
         return render_svg(self.svg, self.width, self.height)
+
+
+def count_shapes(svg: str) -> int:
+    """Closed shapes in SVG text: move-to commands over all path data (a compound path with
+    holes counts once per subpath, as LIVE and DiffVG count one closed curve per path)."""
+    data = " ".join(re.findall(r'\bd="([^"]*)"', svg))
+    return len(re.findall(r"[Mm]", data))
 
 
 def render_svg(svg: str, width: int, height: int) -> np.ndarray:
@@ -115,12 +127,14 @@ def vtracer_trace(
     max_evaluations: int = 48,
     tolerance: float = 0.02,
 ) -> TracedSvg:
-    """VTracer's SVG of ``target`` with a path count as close to ``path_count`` as found.
+    """VTracer's SVG of ``target`` with the most paths found that do not exceed ``path_count``.
 
     For each (color_precision, layer_difference) of :data:`SETTINGS_GRID`, filter_speckle is
-    bisected on a log scale (path counts fall as it grows); the search stops once a count is
-    within ``tolerance`` × ``path_count`` (rounded down, so exact below 50 paths) or after
-    ``max_evaluations`` runs, and keeps the closest result (the first one on ties).
+    bisected on a log scale (path counts fall as it grows); the search stops once a count at
+    most ``path_count`` is within ``tolerance`` × ``path_count`` of it (rounded down, so exact
+    below 50 paths) or after ``max_evaluations`` runs, and keeps the closest count that does not
+    exceed ``path_count`` (the first one on ties). Only when every run gave more paths does it
+    keep the fewest found.
     """
     from PIL import Image
 
@@ -133,7 +147,7 @@ def vtracer_trace(
     good_enough = int(tolerance * path_count)
     cache: dict[tuple[int, int, int], str] = {}
     seconds: dict[tuple[int, int, int], float] = {}
-    best: tuple[int, tuple[int, int, int]] | None = None
+    best: tuple[tuple[bool, int], tuple[int, int, int]] | None = None
 
     def count(speckle: int, precision: int, difference: int) -> int:
         nonlocal best
@@ -143,13 +157,17 @@ def vtracer_trace(
             cache[key] = trace_once(png, speckle, precision, difference)
             seconds[key] = time.perf_counter() - started
         found = len(re.findall(r"<path\b", cache[key]))
-        if best is None or abs(found - path_count) < best[0]:
-            best = (abs(found - path_count), key)
+        rank = (found > path_count, abs(found - path_count))
+        if best is None or rank < best[0]:
+            best = (rank, key)
         return found
+
+    def close_enough() -> bool:
+        return best is not None and best[0] <= (False, good_enough)
 
     low_bound, high_bound = SPECKLE_RANGE
     for precision, difference in SETTINGS_GRID:
-        if len(cache) >= max_evaluations or (best is not None and best[0] <= good_enough):
+        if len(cache) >= max_evaluations or close_enough():
             break
         low, high = low_bound, high_bound
         if count(low, precision, difference) <= path_count:
@@ -159,7 +177,7 @@ def vtracer_trace(
         while high - low > 1 and len(cache) < max_evaluations:
             middle = min(high - 1, max(low + 1, round(math.sqrt(low * high))))
             found = count(middle, precision, difference)
-            if abs(found - path_count) <= good_enough:
+            if close_enough():
                 break
             if found > path_count:
                 low = middle

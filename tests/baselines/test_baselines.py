@@ -10,6 +10,7 @@ from samvg import InputError, VectorImage, VectorPath
 from samvg.baselines import (
     TracedSvg,
     blob,
+    count_shapes,
     live,
     parameter_count,
     path_count,
@@ -116,17 +117,24 @@ def test_live_fits_a_real_image(cactus):
     assert mse(result.render(), cactus) < 0.5 * mse(np.ones_like(cactus), cactus)
 
 
-def test_vtracer_path_count_lands_near_the_target(bench_dir):
+def test_vtracer_path_count_lands_near_the_target_without_exceeding_it(bench_dir):
     image = load(bench_dir, "emoji/twemoji_sunflower.png", 128)
     for wanted in (6, 20):
         traced = vtracer_trace(image, wanted)
         assert isinstance(traced, TracedSvg)
-        assert abs(traced.path_count - wanted) <= max(2, wanted // 5), traced.settings
+        assert wanted - max(2, wanted // 5) <= traced.path_count <= wanted, traced.settings
+        assert traced.shape_count >= traced.path_count
         render = traced.render()
         assert render.shape == (128, 128, 3) and render.dtype == np.float32
         assert mse(render, image) < 0.02
         assert parameter_count(traced) > 6 * traced.path_count
     assert traced.svg.startswith("<?xml")
+
+
+def test_count_shapes_counts_every_subpath():
+    svg = '<svg><path d="M0 0L4 0L4 4Z M1 1L2 1L2 2Z"/><path d="m5 5l1 0l0 1z"/></svg>'
+    assert count_shapes(svg) == 3
+    assert count_shapes("<svg></svg>") == 0
 
 
 def test_run_baseline_gives_one_shape_for_every_method(cactus):
