@@ -48,3 +48,18 @@ def test_identical_gradients_share_one_element():
     fills = [fill for _, fill in read_svg(text).paths]
     assert fills[0] == fills[3] and isinstance(fills[0], LinearGradient)
     assert isinstance(fills[2], RadialGradient)
+
+
+def test_gradient_numbers_are_short_and_read_back_unchanged():
+    square = np.array([[0, 0], [5, 0], [10, 0], [10, 5], [10, 10], [0, 10]], dtype=float)
+    stops = ((0.0, (1.0, 0.0, 0.0)), (0.25, (0.0, 1.0, 0.0)), (1.0, (0.0, 0.0, 1.0)))
+    ramp = LinearGradient(stops=stops, start=(0.5, -0.25), end=(10.0, 0.0))
+    scene = Scene(12, 12, square, np.array([0, 6]), (ramp,))
+    text = scene_to_svg(scene, precision=2)
+    assert 'x1=".5" y1="-.25" x2="10" y2="0"' in text
+    # the first stop's offset is SVG's initial value, so it is left out
+    assert '<stop stop-color="#ff0000"/><stop offset=".25" stop-color="#00ff00"/>' in text
+    fill = read_svg(text).paths[0][1]
+    assert isinstance(fill, LinearGradient)
+    assert fill.stops == stops
+    assert fill.start == (0.5, -0.25) and fill.end == (10.0, 0.0)
