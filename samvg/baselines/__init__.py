@@ -20,7 +20,7 @@ from samvg.optimize import FitSettings
 from samvg.scene import RGB, Scene
 from samvg.vector_image import VectorImage
 
-BASELINES = ("diffvg", "live", "vtracer")
+BASELINES = ("diffvg", "live", "vtracer", "vtracer-shapes")
 #: samvg optimises in two phases (after tracing, after adding missing components); a baseline
 #: given only samvg's `FitSettings` (one phase) gets this many times its steps.
 SAMVG_PHASES = 2
@@ -44,14 +44,16 @@ def run_baseline(
 
     ``fit`` are the settings samvg fits one phase with (its losses, learning rates and steps);
     the optimising baselines run ``steps`` steps in all, by default ``SAMVG_PHASES *
-    fit.steps``, so they get samvg's iterations and losses. ``vtracer`` ignores the fitting
-    arguments. Optimising baselines come back as a `VectorImage` on the target's canvas, with
-    flat fills whatever ``fit`` says about gradients.
+    fit.steps``, so they get samvg's iterations and losses. ``vtracer`` (at most ``path_count``
+    ``<path>`` elements) and ``vtracer-shapes`` (at most ``path_count`` closed shapes, counting
+    every subpath of its compound paths) ignore the fitting arguments. Optimising baselines come
+    back as a `VectorImage` on the target's canvas, with flat fills whatever ``fit`` says about
+    gradients.
     """
     if name not in BASELINES:
         raise InputError(f"unknown baseline {name!r}; choose from {', '.join(BASELINES)}")
-    if name == "vtracer":
-        return vtracer_trace(target, path_count)
+    if name in ("vtracer", "vtracer-shapes"):
+        return vtracer_trace(target, path_count, count="shapes" if name != "vtracer" else "paths")
     if steps is None:
         if fit is None:
             raise InputError("give steps, or samvg's fit settings (steps per phase)")

@@ -13,11 +13,12 @@ import os
 import re
 import time
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
 from samvg.baselines.common import as_target, check_counts
-from samvg.errors import SamvgError
+from samvg.errors import InputError, SamvgError
 from samvg.imaging import to_float_rgb
 from samvg.io import atomic_write_text
 
@@ -46,7 +47,7 @@ class TracedSvg:
     @property
     def path_count(self) -> int:
         """Number of ``<path>`` elements (VTracer's first one is the full-canvas background)."""
-        return len(re.findall(r"<path\b", self.svg))
+        return count_paths(self.svg)
 
     @property
     def parameter_count(self) -> int:
@@ -75,6 +76,11 @@ class TracedSvg:
     def render(self) -> np.ndarray:
         """Rasterize with resvg over white: float32 (H, W, 3) in [0, 1]."""
         return render_svg(self.svg, self.width, self.height)
+
+
+def count_paths(svg: str) -> int:
+    """Number of ``<path>`` elements in SVG text."""
+    return len(re.findall(r"<path\b", svg))
 
 
 def count_shapes(svg: str) -> int:
@@ -126,8 +132,10 @@ def vtracer_trace(
     path_count: int,
     max_evaluations: int = 48,
     tolerance: float = 0.02,
+    count: Literal["paths", "shapes"] = "paths",
 ) -> TracedSvg:
-    """VTracer's SVG of ``target`` with the most paths found that do not exceed ``path_count``.
+    """VTracer's SVG of ``target`` with the most paths found that do not exceed ``path_count``;
+    with ``count="shapes"``, closed shapes (subpaths, see `count_shapes`) instead of paths.
 
     For each (color_precision, layer_difference) of :data:`SETTINGS_GRID`, filter_speckle is
     bisected on a log scale (path counts fall as it grows); the search stops once a count at
@@ -139,6 +147,9 @@ def vtracer_trace(
     from PIL import Image
 
     check_counts(path_count, 1)
+    if count not in ("paths", "shapes"):
+        raise InputError(f"count must be 'paths' or 'shapes', got {count!r}")
+    counted = count_shapes if count == "shapes" else count_paths
     image = np.round(as_target(target) * 255.0).astype(np.uint8)
     height, width = image.shape[:2]
     buffer = io.BytesIO()
@@ -149,14 +160,14 @@ def vtracer_trace(
     seconds: dict[tuple[int, int, int], float] = {}
     best: tuple[tuple[bool, int], tuple[int, int, int]] | None = None
 
-    def count(speckle: int, precision: int, difference: int) -> int:
+    def measure(speckle: int, precision: int, difference: int) -> int:
         nonlocal best
         key = (speckle, precision, difference)
         if key not in cache:
             started = time.perf_counter()
             cache[key] = trace_once(png, speckle, precision, difference)
             seconds[key] = time.perf_counter() - started
-        found = len(re.findall(r"<path\b", cache[key]))
+        found = counted(cache[key])
         rank = (found > path_count, abs(found - path_count))
         if best is None or rank < best[0]:
             best = (rank, key)
@@ -170,13 +181,13 @@ def vtracer_trace(
         if len(cache) >= max_evaluations or close_enough():
             break
         low, high = low_bound, high_bound
-        if count(low, precision, difference) <= path_count:
+        if measure(low, precision, difference) <= path_count:
             continue  # even the finest speckle filter gives too few paths with these settings
-        if count(high, precision, difference) >= path_count:
+        if measure(high, precision, difference) >= path_count:
             continue
         while high - low > 1 and len(cache) < max_evaluations:
             middle = min(high - 1, max(low + 1, round(math.sqrt(low * high))))
-            found = count(middle, precision, difference)
+            found = measure(middle, precision, difference)
             if close_enough():
                 break
             if found > path_count:

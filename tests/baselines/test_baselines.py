@@ -124,6 +124,8 @@ def test_vtracer_path_count_lands_near_the_target_without_exceeding_it(bench_dir
         assert isinstance(traced, TracedSvg)
         assert wanted - max(2, wanted // 5) <= traced.path_count <= wanted, traced.settings
         assert traced.shape_count >= traced.path_count
+        by_shapes = vtracer_trace(image, wanted, count="shapes")
+        assert wanted - max(2, wanted // 5) <= by_shapes.shape_count <= wanted
         render = traced.render()
         assert render.shape == (128, 128, 3) and render.dtype == np.float32
         assert mse(render, image) < 0.02
@@ -139,11 +141,11 @@ def test_count_shapes_counts_every_subpath():
 
 def test_run_baseline_gives_one_shape_for_every_method(cactus):
     options = FitSettings(steps=5, point_learning_rate=1.0, colour_learning_rate=0.01)
-    for name in ("diffvg", "live", "vtracer"):
+    for name in ("diffvg", "live", "vtracer", "vtracer-shapes"):
         result = run_baseline(name, (cactus * 255).astype(np.uint8), 4, options, seed=1)
         assert result.render().shape == (64, 64, 3)
         assert "<svg" in result.to_svg()
-        if name != "vtracer":
+        if not name.startswith("vtracer"):
             assert path_count(result) == 4
             assert parameter_count(result) == 4 * 34  # the paper's 34 numbers per path
 
