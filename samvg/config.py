@@ -162,6 +162,9 @@ class FitOptions:
     lpips_every: int = 1
     """Evaluate LPIPS every this many steps; the steps between reuse its last gradient with
     respect to the render (1: every step, the paper and the default)."""
+    lpips_colours: bool = True
+    """Whether LPIPS moves fill colours as well as shapes (the paper); off, colours follow MSE
+    alone (LPIPS then cannot tint a path a colour the image does not have)."""
     coarse_fraction: float = 0.6
     """The share of each phase's steps fitted first at half size, coarse to fine (0: none, the
     paper)."""

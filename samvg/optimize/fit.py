@@ -57,6 +57,9 @@ class FitSettings:
     bounds: tuple[float, float, float, float] | None = None
     perceptual_every: int = 1
     """Evaluate LPIPS every this many steps and reuse its gradient in between (1: every step)."""
+    perceptual_colours: bool = True
+    """Whether the perceptual term moves paints (colours, gradient stops) as well as geometry;
+    False: paints follow MSE alone, LPIPS shapes only the geometry."""
     coarse_fraction: float = 0.0
     """The share of the steps fitted first at half size (0: all at full size)."""
     coarse_perceptual: bool = True
@@ -100,6 +103,7 @@ class FitSettings:
             learn_alpha=options.translucent,
             bounds=bounds,
             perceptual_every=options.lpips_every,
+            perceptual_colours=options.lpips_colours,
             coarse_fraction=options.coarse_fraction,
             coarse_perceptual=options.coarse_lpips,
             plateau_steps=options.plateau_steps,
@@ -228,6 +232,14 @@ class _Parameters:
     def learns(self) -> bool:
         """Whether there is anything to fit: a path or a background gradient."""
         return self.scene.path_count > 0 or self.background is not None
+
+    def geometry(self) -> list[torch.Tensor]:
+        """The tensors of shape: points and the geometry of gradient paints."""
+        return [self.points] + [
+            variables.geometry
+            for variables in (self.gradients, self.background)
+            if variables is not None
+        ]
 
     def optimizer(self, settings: FitSettings) -> Adam:
         point_group = [self.points]
@@ -391,8 +403,8 @@ def _fit_level(
         with fit_torch_threads(settings.perceptual is not None):
             for step in range(settings.steps):
                 optimizer.zero_grad()
-                loss, reported = objective(parameters.render(), parameters.points, step)
-                loss.backward()
+                loss, perceptual, reported = objective(parameters.render(), parameters.points, step)
+                _backward(loss, perceptual, parameters, settings.perceptual_colours)
                 optimizer.step()
                 parameters.project(settings)
                 losses.append(reported)
@@ -403,6 +415,27 @@ def _fit_level(
                         on_step(first_step + settings.steps - 1, reported)
                     break
     return FitResult(parameters.fitted(), losses)
+
+
+def _backward(
+    loss: torch.Tensor,
+    perceptual: torch.Tensor | None,
+    parameters: _Parameters,
+    perceptual_colours: bool,
+) -> None:
+    """Gradients of ``loss`` + ``perceptual`` into the parameters; without
+    ``perceptual_colours``, the perceptual term's reach only their geometry."""
+    if perceptual is None:
+        loss.backward()
+    elif perceptual_colours:
+        (loss + perceptual).backward()
+    else:
+        loss.backward(retain_graph=True)
+        geometry = parameters.geometry()
+        extra = torch.autograd.grad(perceptual, geometry, allow_unused=True)
+        for tensor, gradient in zip(geometry, extra, strict=True):
+            if gradient is not None:
+                tensor.grad = gradient if tensor.grad is None else tensor.grad + gradient
 
 
 def _plateaued(losses: list[float], window: int | None) -> bool:
@@ -436,15 +469,16 @@ class _Objective:
 
     def __call__(
         self, rendered: torch.Tensor, points: torch.Tensor, step: int
-    ) -> tuple[torch.Tensor, float]:
-        """The loss to differentiate and the objective's value to report."""
+    ) -> tuple[torch.Tensor, torch.Tensor | None, float]:
+        """The loss to differentiate (MSE + Xing), the perceptual term's linear stand-in (None
+        without it) and the objective's value to report."""
         settings = self.settings
         loss = functional.mse_loss(rendered, self.target)
         if settings.xing_weight > 0:
             loss = loss + settings.xing_weight * xing_loss(points, indices=self.indices)
         perceptual = settings.perceptual
         if perceptual is None or settings.perceptual_weight <= 0:
-            return loss, float(loss.detach())
+            return loss, None, float(loss.detach())
         if step % settings.perceptual_every == 0 or self.perceptual_gradient is None:
             with torch_threads(render_threads()):
                 image = rendered.detach().requires_grad_(True)
@@ -453,4 +487,4 @@ class _Objective:
             self.perceptual_gradient = gradient * settings.perceptual_weight
             self.perceptual_value = settings.perceptual_weight * float(value.detach())
         reported = float(loss.detach()) + self.perceptual_value
-        return loss + torch.sum(rendered * self.perceptual_gradient), reported
+        return loss, torch.sum(rendered * self.perceptual_gradient), reported

@@ -91,8 +91,8 @@ def test_reused_lpips_gradient_is_exact_where_evaluated_and_stale_between(lpips_
 
     def gradients(render: np.ndarray, step: int) -> tuple[torch.Tensor, float]:
         image = torch.from_numpy(render).requires_grad_(True)
-        loss, reported = objective(image, points, step)
-        loss.backward()
+        loss, linear_term, reported = objective(image, points, step)
+        (loss + linear_term).backward()
         return image.grad, reported
 
     first = rng.random((40, 48, 3)).astype(np.float32)
@@ -109,6 +109,27 @@ def test_reused_lpips_gradient_is_exact_where_evaluated_and_stale_between(lpips_
     torch.testing.assert_close(stale - mse_part, at_zero - first_mse)
     fresh, _ = gradients(second, 3)
     assert not torch.allclose(fresh, stale)
+
+
+def test_without_perceptual_colours_lpips_moves_shapes_but_not_colours():
+    target = scene_of([(square(20, 24, 24), (0.9, 0.2, 0.1, 1.0))]).render()
+    start = scene_of([(square(20, 24, 24), (0.9, 0.2, 0.1, 1.0))])
+
+    def wants_blue(rendered: torch.Tensor) -> torch.Tensor:
+        return 1.0 - rendered[..., 2].mean()  # a stand-in for LPIPS that rewards blue
+
+    def fitted(**perceptual: object) -> Scene:
+        return fit_scene(start, target, FitSettings(steps=120, **perceptual)).scene
+
+    plain = fitted()
+    tinted = fitted(perceptual=wants_blue, perceptual_weight=0.5)
+    shaped = fitted(perceptual=wants_blue, perceptual_weight=0.5, perceptual_colours=False)
+    assert tinted.colours()[0, 2] > 0.5  # LPIPS on colours tints the red square blue
+    red, green, blue = shaped.colours()[0, :3]
+    assert red > 0.85 and green < 0.2 and blue < 0.1  # MSE keeps it red (edges shift it a bit)
+    # the shape still feels the term: the square shrinks to show more of the white (blue) ground
+    red_area = lambda scene: int((scene.render()[..., 2] < 0.5).sum())  # noqa: E731
+    assert red_area(plain) == 24 * 24 and red_area(shaped) < 24 * 24 - 80
 
 
 def test_coarse_to_fine_fit_lands_on_the_full_canvas():
