@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 import shapely
-from bench_images import REPO, bench_entries, run_samvg, vtracer_default
+from bench_images import REPO, bench_entries, run_samvg, setting_value, vtracer_default
 
 import samvg
 from samvg.baselines import render_svg
@@ -102,16 +102,21 @@ def run_one(
     return record
 
 
-def configs(name: str, paths: int | None) -> samvg.Config:
+def configs(name: str, paths: int | None, overrides: dict[str, Any] | None = None) -> samvg.Config:
+    overrides = overrides or {}
     if name == "default":
-        return samvg.Config()
+        return samvg.Config(**overrides)
     if name == "fixed5":
-        return samvg.Config(segments=5, max_paths=paths)
+        return samvg.Config(segments=5, max_paths=paths, **overrides)
     raise SystemExit(f"unknown setting {name!r}")
 
 
 def run_all(
-    entries: list[dict[str, str]], out: Path, names: list[str], keep_svg: Path | None = None
+    entries: list[dict[str, str]],
+    out: Path,
+    names: list[str],
+    keep_svg: Path | None = None,
+    overrides: dict[str, Any] | None = None,
 ) -> None:
     out.mkdir(parents=True, exist_ok=True)
     lpips = load_lpips()
@@ -126,10 +131,12 @@ def run_all(
                 if not reference.exists():
                     continue
                 paths = json.loads(reference.read_text())["paths"]
-            config = configs(name, paths)
+            config = configs(name, paths, overrides)
             kept = keep_svg / name if keep_svg is not None else None
             record = run_one(entry, config, lpips, with_vtracer=name == "default", keep_svg=kept)
             record["setting"] = name
+            if overrides:
+                record["overrides"] = overrides
             atomic_write_text(record_file, json.dumps(record, indent=1))
             print(json.dumps(record), flush=True)
 
@@ -241,13 +248,24 @@ def main() -> None:
     parser.add_argument(
         "--keep-svg", type=Path, help="also write samvg's SVGs to <this folder>/<setting>/"
     )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a samvg setting for every run (kept in each record), e.g. lpips_colours=false",
+    )
     arguments = parser.parse_args()
+    overrides = {}
+    for text in arguments.set:
+        name, _, value = text.partition("=")
+        overrides[name] = setting_value(value)
     names = arguments.settings.split(",")
     shard, shards = (int(part) for part in arguments.shard.split("/"))
     if not arguments.report_only:
         categories = arguments.categories.split(",") if arguments.categories else None
         entries = bench_entries(arguments.per_category, categories)[shard::shards]
-        run_all(entries, arguments.out, names, arguments.keep_svg)
+        run_all(entries, arguments.out, names, arguments.keep_svg, overrides)
     write_report(arguments.out, names, arguments.report)
 
 
