@@ -55,6 +55,9 @@ RECORD_FIELDS = (
     "target_complexity",
     "details",
 )
+#: Config fields added after a run may have started, with the value that behaves as samvg did
+#: before they existed: a run file without them holds that value.
+_ADDED_SETTINGS: dict[str, Any] = {"lpips_colours": True}
 #: Config fields that do not change results (paths, device) and so may differ on a rerun.
 _FREE_SETTINGS = ("checkpoint", "lpips_weights", "device")
 
@@ -130,6 +133,7 @@ def _check_settings(layout: Layout, settings: dict[str, Any]) -> None:
             earlier = json.loads(layout.run_file.read_text(encoding="utf-8"))["settings"]
         except (OSError, json.JSONDecodeError, KeyError, TypeError):
             raise InputError(f"{layout.run_file} is not a samvg-bench run file") from None
+        earlier = {**_ADDED_SETTINGS, **earlier}
         changed = sorted(
             key for key in set(earlier) | set(settings) if earlier.get(key) != settings.get(key)
         )

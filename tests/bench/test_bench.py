@@ -157,6 +157,18 @@ def test_run_writes_results_resumes_and_records_failures(tiny_manifest, tmp_path
             iterations=4,
         )
 
+    # a run file from before a setting existed holds the value that behaves as samvg did then
+    run_file = out / "run.json"
+    info = json.loads(run_file.read_text())
+    assert info["settings"].pop("lpips_colours") is True
+    run_file.write_text(json.dumps(info))
+    resumed = run_bench(tiny_manifest, out, methods, config=config, method_table=TABLE,
+                        lpips_weights=lpips_file, report=False, **TINY)  # fmt: skip
+    assert resumed.skipped == 15
+    with pytest.raises(InputError, match="lpips_colours: True -> False"):
+        run_bench(tiny_manifest, out, methods, config=config.replace(lpips_colours=False),
+                  method_table=TABLE, lpips_weights=lpips_file, report=False, **TINY)  # fmt: skip
+
 
 def test_report_in_the_papers_layout(tiny_manifest, tmp_path, lpips_file, fid_file):
     out = tmp_path / "out"
