@@ -14,6 +14,7 @@ Layout of the output folder::
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import itertools
 import json
@@ -33,7 +34,7 @@ from samvg.bench.manifest import BenchImage, read_manifest
 from samvg.bench.measure import IMAGE_METRICS, Scorer
 from samvg.bench.methods import DEFAULT_METHODS, METHODS, Method, MethodRun
 from samvg.bench.report import write_report
-from samvg.config import Config
+from samvg.config import Config, FinishOptions
 from samvg.errors import InputError
 from samvg.imaging import resize_longest, to_float_rgb
 from samvg.io import atomic_write_text, read_image, write_png
@@ -56,7 +57,8 @@ RECORD_FIELDS = (
     "details",
 )
 #: Config fields added after a run may have started, with the value that behaves as samvg did
-#: before they existed: a run file without them holds that value.
+#: before they existed: a run file without them holds that value. (The finish pass's options
+#: need no entry: they are compared only where the finish pass runs.)
 _ADDED_SETTINGS: dict[str, Any] = {"lpips_colours": True}
 #: Config fields that do not change results (paths, device) and so may differ on a rerun.
 _FREE_SETTINGS = ("checkpoint", "lpips_weights", "device")
@@ -134,8 +136,13 @@ def _check_settings(layout: Layout, settings: dict[str, Any]) -> None:
         except (OSError, json.JSONDecodeError, KeyError, TypeError):
             raise InputError(f"{layout.run_file} is not a samvg-bench run file") from None
         earlier = {**_ADDED_SETTINGS, **earlier}
+        inert = set()
+        if not earlier.get("finish_pass", True) and not settings.get("finish_pass", True):
+            inert = {field.name for field in dataclasses.fields(FinishOptions)} - {"finish_pass"}
         changed = sorted(
-            key for key in set(earlier) | set(settings) if earlier.get(key) != settings.get(key)
+            key
+            for key in set(earlier) | set(settings)
+            if key not in inert and earlier.get(key) != settings.get(key)
         )
         if changed:
             detail = ", ".join(f"{k}: {earlier.get(k)!r} -> {settings.get(k)!r}" for k in changed)

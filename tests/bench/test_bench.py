@@ -165,8 +165,19 @@ def test_run_writes_results_resumes_and_records_failures(tiny_manifest, tmp_path
     resumed = run_bench(tiny_manifest, out, methods, config=config, method_table=TABLE,
                         lpips_weights=lpips_file, report=False, **TINY)  # fmt: skip
     assert resumed.skipped == 15
+    # the finish pass's options are compared only where it runs
+    finish_off = config.replace(finish_pass=False)
+    run_file.write_text(json.dumps(info))
+    with pytest.raises(InputError, match="finish_pass: True -> False"):
+        run_bench(tiny_manifest, out, methods, config=finish_off, method_table=TABLE,
+                  lpips_weights=lpips_file, report=False, **TINY)  # fmt: skip
+    info["settings"].update(finish_pass=False, whole_pixels=False)
+    run_file.write_text(json.dumps(info))
+    resumed = run_bench(tiny_manifest, out, methods, config=finish_off, method_table=TABLE,
+                        lpips_weights=lpips_file, report=False, **TINY)  # fmt: skip
+    assert resumed.skipped == 15
     with pytest.raises(InputError, match="lpips_colours: True -> False"):
-        run_bench(tiny_manifest, out, methods, config=config.replace(lpips_colours=False),
+        run_bench(tiny_manifest, out, methods, config=finish_off.replace(lpips_colours=False),
                   method_table=TABLE, lpips_weights=lpips_file, report=False, **TINY)  # fmt: skip
 
 
