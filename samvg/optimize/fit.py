@@ -424,7 +424,7 @@ def _backward(
     perceptual_colours: bool,
 ) -> None:
     """Gradients of ``loss`` + ``perceptual`` into the parameters; without
-    ``perceptual_colours``, the perceptual term's reach only their geometry."""
+    ``perceptual_colours``, the perceptual term reaches only their geometry."""
     if perceptual is None:
         loss.backward()
     elif perceptual_colours:
