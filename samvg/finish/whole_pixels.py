@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from samvg.finish.simplicity import crossing_paths
-from samvg.optimize.reduce import IDLE_COST, window_change
+from samvg.optimize.reduce import IDLE_COST, smallest_changes_first, window_change
 from samvg.scene import Scene
 
 #: The most the picture may change from all roundings together, as a share of the scene's MSE.
@@ -45,28 +45,24 @@ def whole_pixel_paths(
     current = scene.on_canvas(width, height, factor)
     boxes = current.path_boxes()
     kept = np.ones(scene.path_count, dtype=bool)
-    changes = [
-        window_change(current, boxes, kept, index, _part(rounded, scene, index) * factor)
-        for index in candidates
-    ]
     points = scene.points.copy()
-    count = 0
-    for order in np.argsort(changes, kind="stable"):
-        if changes[order] >= tolerance:
-            break
-        index = candidates[int(order)]
+
+    def change_of(candidate: int) -> float:
+        index = candidates[candidate]
+        return window_change(current, boxes, kept, index, _part(rounded, scene, index) * factor)
+
+    def round_path(candidate: int) -> None:
+        nonlocal current
+        index = candidates[candidate]
         replacement = _part(rounded, scene, index) * factor
-        change = window_change(current, boxes, kept, index, replacement)
-        if change >= tolerance or change > budget:
-            continue
-        budget -= change
         start, end = scene.offsets[index], scene.offsets[index + 1]
         points[start:end] = rounded[start:end]
         moved = current.points.copy()
         moved[start:end] = replacement
         current = current.with_geometry(moved)
         boxes[index] = np.concatenate([replacement.min(axis=0), replacement.max(axis=0)])
-        count += 1
+
+    count, _ = smallest_changes_first(len(candidates), change_of, round_path, tolerance, budget)
     return (scene.with_geometry(points) if count else scene), count
 
 

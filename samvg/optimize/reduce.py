@@ -12,6 +12,7 @@ in time that follows the path's size rather than the canvas's."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -111,6 +112,32 @@ def window_change(
     return float(squared) / (scene.width * scene.height * 3)
 
 
+def smallest_changes_first(
+    count: int,
+    change_of: Callable[[int], float],
+    apply: Callable[[int], None],
+    tolerance: float,
+    budget: float,
+) -> tuple[int, float]:
+    """The greedy step of every idle edit: of candidates ``0 .. count - 1`` whose change (by
+    ``change_of``) is under ``tolerance``, smallest first, each is measured again (against the
+    edits applied before it) and applied (``apply``) when still under ``tolerance`` and within
+    what is left of ``budget``. Returns how many were applied and the budget left."""
+    first = [change_of(index) for index in range(count)]
+    left = budget
+    applied = 0
+    for order in np.argsort(first, kind="stable"):
+        index = int(order)
+        if first[index] >= tolerance:
+            break
+        change = change_of(index)
+        if change < tolerance and change <= left:
+            apply(index)
+            left -= change
+            applied += 1
+    return applied, left
+
+
 def _with_paint(scene: Scene, index: int, paint: Paint) -> Scene:
     paints = list(scene.paints)
     paints[index] = paint
@@ -175,17 +202,19 @@ def flatten_idle_gradients(
     budget = share * float(np.mean((scene.render() - target) ** 2))
     kept = np.ones(scene.path_count, dtype=bool)
     boxes = scene.path_boxes()
-    changes = [_gradient_change(scene, boxes, kept, index)[1] for index in gradients]
-    flattened = 0
-    for order in np.argsort(changes, kind="stable"):
-        if changes[order] >= tolerance:
-            break
-        index = gradients[int(order)]
-        paint, change = _gradient_change(scene, boxes, kept, index)
-        if change < tolerance and change <= budget:
-            scene = _with_paint(scene, index, paint)
-            budget -= change
-            flattened += 1
+    stand_ins: dict[int, Paint] = {}
+
+    def change_of(candidate: int) -> float:
+        stand_ins[candidate], change = _gradient_change(scene, boxes, kept, gradients[candidate])
+        return change
+
+    def make_flat(candidate: int) -> None:
+        nonlocal scene
+        scene = _with_paint(scene, gradients[candidate], stand_ins[candidate])
+
+    flattened, budget = smallest_changes_first(
+        len(gradients), change_of, make_flat, tolerance, budget
+    )
     if scene.background_gradient is not None:
         colour, squared = _flat_background(scene)
         change = squared / (scene.width * scene.height * 3)
@@ -206,16 +235,16 @@ def remove_idle_paths(
     the LPIPS term of the fit put there."""
     kept = np.ones(scene.path_count, dtype=bool)
     boxes = scene.path_boxes()
-    changes = np.array([window_change(scene, boxes, kept, i) for i in range(scene.path_count)])
-    if not np.any(changes < tolerance):
-        return scene, 0
+
+    def remove(index: int) -> None:
+        kept[index] = False
+
     budget = share * float(np.mean((scene.render() - target) ** 2))
-    for index in np.argsort(changes, kind="stable"):
-        if changes[index] >= tolerance:
-            break
-        change = window_change(scene, boxes, kept, int(index))
-        if change < tolerance and change <= budget:
-            kept[index] = False
-            budget -= change
-    removed = int(np.count_nonzero(~kept))
+    removed, _ = smallest_changes_first(
+        scene.path_count,
+        lambda index: window_change(scene, boxes, kept, index),
+        remove,
+        tolerance,
+        budget,
+    )
     return (scene.subset(np.flatnonzero(kept)) if removed else scene), removed

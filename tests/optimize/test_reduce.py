@@ -3,6 +3,7 @@
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from samvg.optimize.reduce import (
     IDLE_COST,
@@ -11,6 +12,7 @@ from samvg.optimize.reduce import (
     reduce_paths,
     removal_costs,
     remove_idle_paths,
+    smallest_changes_first,
     window_change,
 )
 from samvg.scene import FlatPaint, LinearGradient, RadialGradient, Scene
@@ -164,3 +166,19 @@ def test_no_gradient_goes_flat_beyond_the_budget():
     picture = scene.render()
     assert flatten_idle_gradients(scene, picture, IDLE_COST)[1] == 0  # the scene has no error
     assert flatten_idle_gradients(scene, picture + 0.01, IDLE_COST)[1] == 1
+
+
+def test_smallest_changes_first_measures_again_and_keeps_to_the_budget():
+    applied: list[int] = []
+    base = [0.3, 0.1, 0.5, 0.2, 2.0]
+
+    def change_of(index: int) -> float:
+        if index == 3 and 1 in applied:  # 3 and 1 are copies: once 1 goes, 3 changes much
+            return 5.0
+        return base[index]
+
+    count, left = smallest_changes_first(5, change_of, applied.append, 1.0, 0.7)
+    # order by first change: 1 (0.1), 3 (now 5.0: kept), 0 (0.3), 2 (0.5 > 0.3 left); 4 never
+    assert applied == [1, 0] and count == 2 and left == pytest.approx(0.3)
+    assert smallest_changes_first(2, lambda i: 3.0, applied.append, 1.0, 1.0) == (0, 1.0)
+    assert applied == [1, 0]  # nothing under the tolerance: nothing applied
