@@ -12,6 +12,7 @@ import math
 import os
 import re
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -90,6 +91,14 @@ def count_shapes(svg: str) -> int:
     return len(re.findall(r"[Mm]", data))
 
 
+def _counter(count: str) -> Callable[[str], int]:
+    """`count_paths` or `count_shapes` by name; `InputError` for another name."""
+    counters = {"paths": count_paths, "shapes": count_shapes}
+    if count not in counters:
+        raise InputError(f"count must be 'paths' or 'shapes', got {count!r}")
+    return counters[count]
+
+
 def render_svg(svg: str, width: int, height: int) -> np.ndarray:
     """Render SVG text with resvg at ``width`` × ``height`` over white, float32 (H, W, 3)."""
     from PIL import Image
@@ -147,9 +156,7 @@ def vtracer_trace(
     from PIL import Image
 
     check_counts(path_count, 1)
-    if count not in ("paths", "shapes"):
-        raise InputError(f"count must be 'paths' or 'shapes', got {count!r}")
-    counted = count_shapes if count == "shapes" else count_paths
+    counted = _counter(count)
     image = np.round(as_target(target) * 255.0).astype(np.uint8)
     height, width = image.shape[:2]
     buffer = io.BytesIO()

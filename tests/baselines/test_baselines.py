@@ -153,6 +153,8 @@ def test_run_baseline_gives_one_shape_for_every_method(cactus):
 def test_run_baseline_rejects_bad_requests(cactus):
     with pytest.raises(InputError, match="unknown baseline"):
         run_baseline("potrace", cactus, 4, FitSettings(steps=1))
+    with pytest.raises(InputError, match="count must be 'paths' or 'shapes'"):
+        vtracer_trace(cactus, 4, count="holes")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="path count"):
         run_baseline("diffvg", cactus, 0, FitSettings(steps=1))
     with pytest.raises(InputError, match="steps"):
