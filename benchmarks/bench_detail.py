@@ -29,7 +29,7 @@ from bench_images import REPO, bench_entries, run_samvg, setting_value, working_
 from PIL import Image
 
 import samvg
-from samvg.baselines import count_shapes, render_svg, run_baseline
+from samvg.baselines import count_paths, count_shapes, render_svg, run_baseline
 from samvg.baselines.vtracer_baseline import trace_once
 from samvg.imaging import to_float_rgb
 from samvg.io import atomic_write_text
@@ -85,7 +85,7 @@ def baseline_record(entry: dict[str, str], method: str, paths: int, lpips: Any) 
     svg = result.to_svg()
     height, width = target.shape[:2]
     return {
-        "paths": svg.count("<path"),
+        "paths": count_paths(svg),
         "shapes": count_shapes(svg),
         "svg_bytes": len(svg.encode()),
         "seconds": seconds,
@@ -103,7 +103,7 @@ def vtracer_record(entry: dict[str, str], setting: tuple[int, int, int], lpips: 
     seconds = time.perf_counter() - started
     height, width = target.shape[:2]
     return {
-        "paths": svg.count("<path"),
+        "paths": count_paths(svg),
         "shapes": count_shapes(svg),
         "svg_bytes": len(svg.encode()),
         "seconds": seconds,

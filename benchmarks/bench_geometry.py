@@ -24,7 +24,7 @@ import shapely
 from bench_images import REPO, bench_entries, run_samvg, setting_value, vtracer_default
 
 import samvg
-from samvg.baselines import render_svg
+from samvg.baselines import count_paths, render_svg
 from samvg.finish import flatten_paths
 from samvg.io import atomic_write_text
 from samvg.metrics import load_lpips, lpips_distance
@@ -94,7 +94,7 @@ def run_one(
         svg = vtracer_default(run.working)
         theirs = np.clip(render_svg(svg, render.shape[1], render.shape[0]), 0, 1)
         record.update(
-            vtracer_paths=svg.count("<path"),
+            vtracer_paths=count_paths(svg),
             vtracer_bytes=len(svg.encode()),
             vtracer_mse=float(np.mean((theirs - run.target) ** 2)),
             vtracer_lpips=lpips_distance(lpips, theirs, run.target),

@@ -33,7 +33,7 @@ from bench_images import (
 from PIL import Image, ImageDraw
 
 import samvg
-from samvg.baselines import render_svg
+from samvg.baselines import count_paths, render_svg
 from samvg.config import PRESETS
 from samvg.imaging import to_float_rgb
 
@@ -59,7 +59,7 @@ def row_for(
     ours = run.render()
     svg = vtracer_default(run.working)
     theirs = render_svg(svg, target.shape[1], target.shape[0])
-    paths_theirs = svg.count("<path")
+    paths_theirs = count_paths(svg)
 
     def mse(picture: np.ndarray) -> float:
         return float(np.mean((picture - target) ** 2))

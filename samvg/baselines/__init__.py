@@ -14,7 +14,13 @@ import numpy as np
 from samvg.baselines.common import WHITE, StepProgress, as_target, blob
 from samvg.baselines.live import live, schedule
 from samvg.baselines.random_init import random_blobs, random_init
-from samvg.baselines.vtracer_baseline import TracedSvg, count_shapes, render_svg, vtracer_trace
+from samvg.baselines.vtracer_baseline import (
+    TracedSvg,
+    count_paths,
+    count_shapes,
+    render_svg,
+    vtracer_trace,
+)
 from samvg.errors import InputError
 from samvg.optimize import FitSettings
 from samvg.scene import RGB, Scene
@@ -99,6 +105,7 @@ __all__ = [
     "Vectorized",
     "as_target",
     "blob",
+    "count_paths",
     "count_shapes",
     "live",
     "parameter_count",

@@ -117,14 +117,18 @@ def smallest_changes_first(
     change_of: Callable[[int], float],
     apply: Callable[[int], None],
     tolerance: float,
-    budget: float,
+    budget: float | Callable[[], float],
 ) -> tuple[int, float]:
     """The greedy step of every idle edit: of candidates ``0 .. count - 1`` whose change (by
     ``change_of``) is under ``tolerance``, smallest first, each is measured again (against the
     edits applied before it) and applied (``apply``) when still under ``tolerance`` and within
-    what is left of ``budget``. Returns how many were applied and the budget left."""
+    what is left of ``budget``. Returns how many were applied and the budget left. A callable
+    ``budget`` (a full render, say) is called only when some candidate is under ``tolerance``;
+    when none is, the budget left is reported as 0."""
     first = [change_of(index) for index in range(count)]
-    left = budget
+    if not any(change < tolerance for change in first):
+        return 0, budget if isinstance(budget, float) else 0.0
+    left = budget() if callable(budget) else budget
     applied = 0
     for order in np.argsort(first, kind="stable"):
         index = int(order)
@@ -239,12 +243,11 @@ def remove_idle_paths(
     def remove(index: int) -> None:
         kept[index] = False
 
-    budget = share * float(np.mean((scene.render() - target) ** 2))
     removed, _ = smallest_changes_first(
         scene.path_count,
         lambda index: window_change(scene, boxes, kept, index),
         remove,
         tolerance,
-        budget,
+        lambda: share * float(np.mean((scene.render() - target) ** 2)),
     )
     return (scene.subset(np.flatnonzero(kept)) if removed else scene), removed

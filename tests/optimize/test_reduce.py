@@ -182,3 +182,16 @@ def test_smallest_changes_first_measures_again_and_keeps_to_the_budget():
     assert applied == [1, 0] and count == 2 and left == pytest.approx(0.3)
     assert smallest_changes_first(2, lambda i: 3.0, applied.append, 1.0, 1.0) == (0, 1.0)
     assert applied == [1, 0]  # nothing under the tolerance: nothing applied
+
+
+def test_smallest_changes_first_calls_a_lazy_budget_only_when_needed():
+    calls: list[int] = []
+
+    def budget() -> float:
+        calls.append(1)
+        return 0.7
+
+    assert smallest_changes_first(2, lambda i: 3.0, calls.append, 1.0, budget) == (0, 0.0)
+    assert calls == []  # nothing under the tolerance: the budget (a full render) never measured
+    count, left = smallest_changes_first(2, lambda i: 0.25, lambda i: None, 1.0, budget)
+    assert calls == [1] and count == 2 and left == pytest.approx(0.2)
