@@ -118,13 +118,47 @@ def offer_colour_parts(
 ) -> int:
     """Split every mask kept on ``canvas`` (and, with ``include_uncovered``, the pixels no mask
     covers, which the background fills) into colour-coherent parts and offer the parts to the
-    canvas, largest first; returns how many were kept. ``lab``: the target in CIELAB, when the
-    caller has it already."""
+    canvas, largest first; returns how many were kept. Then the parts the filter turned down are
+    offered again together, one region's parts of one colour as one mask (a folder's stripes:
+    each too faint alone to pass the filter, the set of them plain to see; traced, each stripe
+    is a path). ``lab``: the target in CIELAB, when the caller has it already."""
     lab = lab_image(canvas.target) if lab is None else lab
     regions = list(canvas.kept_masks)
     if include_uncovered and not canvas.covered.all():
         regions.append(~canvas.covered)
-    parts = [part for region in regions for part in colour_parts(region, lab, settings)]
-    parts.sort(key=lambda part: -int(np.count_nonzero(part)))
+    found = [(source, part) for source, region in enumerate(regions)
+             for part in colour_parts(region, lab, settings)]  # fmt: skip
+    found.sort(key=lambda item: -int(np.count_nonzero(item[1])))
     forced = None if use_filter else True
-    return sum(canvas.offer(part, keep=forced).kept for part in parts)
+    decisions = [canvas.offer(part, keep=forced).kept for _, part in found]
+    kept = sum(decisions)
+    if not use_filter:
+        return kept
+    for source in range(len(regions)):  # too small alone, they may matter together: stripes
+        rejected = [
+            part
+            for (at, part), taken in zip(found, decisions, strict=True)
+            if at == source and not taken
+        ]
+        for group in same_colour_groups(rejected, lab, settings.fine_contrast / 2):
+            kept += len(group) * canvas.offer(np.logical_or.reduce(group)).kept
+    return kept
+
+
+def same_colour_groups(
+    parts: list[np.ndarray], lab: np.ndarray, tolerance: float
+) -> list[list[np.ndarray]]:
+    """``parts`` gathered by mean colour (CIELAB, each within ``tolerance`` ΔE of its group's
+    first part, largest first), the groups of two or more parts only, largest first."""
+    parts = sorted(parts, key=lambda part: -int(np.count_nonzero(part)))
+    groups: list[tuple[np.ndarray, list[np.ndarray]]] = []
+    for part in parts:
+        colour = lab[part].mean(axis=0)
+        for first, members in groups:
+            if np.linalg.norm(colour - first) < tolerance:
+                members.append(part)
+                break
+        else:
+            groups.append((colour, [part]))
+    found = [members for _, members in groups if len(members) > 1]
+    return sorted(found, key=lambda members: -sum(int(np.count_nonzero(m)) for m in members))

@@ -8,7 +8,7 @@ from scipy import ndimage
 
 from samvg.segment.colour_split import ColourSplitSettings, colour_parts, lab_image
 from samvg.segment.impact import ImpactCanvas
-from samvg.segment.select import offer_colour_parts
+from samvg.segment.select import offer_colour_parts, same_colour_groups
 
 SETTINGS = ColourSplitSettings(min_pixels=20)
 RED, WHITE, BLUE = (0.8, 0.1, 0.15), (0.97, 0.95, 0.85), (0.1, 0.2, 0.7)
@@ -88,3 +88,62 @@ def test_parts_are_offered_to_the_canvas_and_lower_its_error() -> None:
     assert canvas.mean_error < before / 2  # the parent keeps its mean colour until the fit
     red_part = canvas.kept_masks[-1]
     assert ndimage.label(red_part)[1] == 1 and np.allclose(image[red_part], RED)
+
+
+def _shaded_stripes(size: int = 96) -> tuple[np.ndarray, np.ndarray]:
+    """A grey panel shaded left to right (L* about 61 to 63) with darker stripes 7 ΔE below
+    it, 4 px tall every 10 px (a Tango folder's back), on white, and its mask."""
+    image = np.full((size, size, 3), 0.95, dtype=np.float32)
+    mask = np.zeros((size, size), dtype=bool)
+    mask[8:88, 8:88] = True
+    shade = np.linspace(0.55, 0.58, size, dtype=np.float32)
+    image[8:88, 8:88] = shade[None, 8:88, None]
+    for top in range(14, 84, 10):
+        image[top : top + 4, 8:88] -= 0.065
+    return image, mask
+
+
+def test_faint_flat_stripes_split_but_a_ramp_of_that_range_stays_whole() -> None:
+    image, mask = _shaded_stripes()
+    lab = lab_image(image)
+    stripes = np.zeros_like(mask)
+    for top in range(14, 84, 10):
+        stripes[top : top + 4, 8:88] = True
+    gap = np.linalg.norm(lab[20, 40] - lab[14, 40])
+    assert 5 < gap < SETTINGS.contrast  # below the contrast that splits any two colours
+    parts = colour_parts(mask, lab, SETTINGS)
+    assert len(parts) == 7
+    assert all(stripes[part].mean() > 0.95 for part in parts)
+
+    ramp = _image(96)
+    ramp[8:88, 8:88] = np.linspace(0.45, 0.6, 80, dtype=np.float32)[None, :, None]
+    ramp_lab = lab_image(ramp)
+    assert 5 < np.linalg.norm(ramp_lab[20, 87] - ramp_lab[20, 8]) / 2 < SETTINGS.contrast
+    assert colour_parts(mask, ramp_lab, SETTINGS) == []
+
+
+def test_stripes_too_small_alone_are_kept_together() -> None:
+    image, mask = _shaded_stripes()
+    canvas = ImpactCanvas(image, threshold=1e-4)
+    canvas.offer(np.ones(mask.shape, dtype=bool), keep=True)
+    canvas.offer(mask)
+    for part in colour_parts(mask, lab_image(image), SETTINGS):
+        assert canvas.impact_of(part)[0] < 1e-4  # each stripe alone falls under the threshold
+    before = canvas.mean_error
+    assert offer_colour_parts(canvas, SETTINGS) == 7
+    stripes = canvas.kept_masks[-1]
+    assert ndimage.label(stripes)[1] == 7  # one mask of seven stripes: seven paths when traced
+    assert canvas.mean_error < before
+
+
+def test_same_colour_groups_gather_parts_by_colour() -> None:
+    image = _image()
+    lab_parts = []
+    for left, colour in ((4, RED), (20, BLUE), (36, RED), (52, WHITE)):
+        part = np.zeros((64, 64), dtype=bool)
+        part[10:20, left : left + 8] = True
+        image[part] = colour
+        lab_parts.append(part)
+    groups = same_colour_groups(lab_parts, lab_image(image), 2.0)
+    assert len(groups) == 1 and len(groups[0]) == 2  # the two red ones; blue and white alone
+    assert all(np.allclose(image[part], RED) for part in groups[0])
