@@ -186,8 +186,10 @@ def main() -> None:
     parser.add_argument(
         "--fallback",
         type=Path,
+        action="append",
+        default=[],
         help="report: budget records missing from --records are taken from this folder (an "
-        "older commit's baselines)",
+        "older commit's baselines); repeat it to look in several, in order",
     )
     parser.add_argument(
         "--geometry",

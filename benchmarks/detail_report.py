@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from collections import defaultdict
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -79,7 +80,7 @@ def default_table(geometry: Path) -> list[str]:
 
 
 def budget_tables(
-    records: list[dict[str, Any]], folder: Path, fallback: Path | None = None
+    records: list[dict[str, Any]], folder: Path, fallback: Sequence[Path] = ()
 ) -> list[str]:
     """Per budget and category: each method's means, and samvg's wins against each baseline
     (lower MSE and lower LPIPS on the same image). samvg is its default (gradient fills) where
@@ -104,8 +105,10 @@ def budget_tables(
         "method's record; *wins* = images where samvg has lower MSE **and** lower LPIPS than "
         "that method (the goal: ≥ 90 % in every category)."
         + (
-            f" Records that folder lacks come from `{_shown(fallback)}` (`--fallback`)."
-            if fallback is not None
+            " Records that folder lacks come from "
+            + ", then ".join(f"`{_shown(folder)}`" for folder in fallback)
+            + " (`--fallback`)."
+            if fallback
             else ""
         ),
     ]
@@ -326,25 +329,25 @@ def _subject(rows: list[dict[str, Any]]) -> str:
     return "samvg-gradients" if any(r["method"] == "samvg-gradients" for r in rows) else "samvg"
 
 
-def with_fallback(records: list[dict[str, Any]], fallback: Path | None) -> list[dict[str, Any]]:
-    """``records`` and the budget records of ``fallback`` for the (image, method, budget) they
-    lack (an older commit's baselines, or budgets not rerun)."""
-    if fallback is None:
-        return records
-    have = {(r["id"], r["method"], r.get("budget")) for r in records}
-    extra = [
-        r
-        for r in _records(fallback, "*.json")
-        if (r["id"], r["method"], r.get("budget")) not in have
-    ]
-    return records + extra
+def with_fallback(records: list[dict[str, Any]], fallback: Sequence[Path]) -> list[dict[str, Any]]:
+    """``records`` and the budget records of the ``fallback`` folders, in order, for the
+    (image, method, budget) they lack (an older commit's baselines, or budgets not rerun)."""
+    records = list(records)
+    for folder in fallback:
+        have = {(r["id"], r["method"], r.get("budget")) for r in records}
+        records += [
+            r
+            for r in _records(folder, "*.json")
+            if (r["id"], r["method"], r.get("budget")) not in have
+        ]
+    return records
 
 
 def write_report(
     records_folder: Path,
     geometry: list[Path],
     budget_folder: Path | None = None,
-    fallback: Path | None = None,
+    fallback: Sequence[Path] = (),
 ) -> None:
     """detail.md from the records: the default against VTracer (a table per folder of
     ``geometry``), the equal-budget
