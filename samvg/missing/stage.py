@@ -71,7 +71,7 @@ class MissingSettings:
             min_pixels=config.segment.min_pixels(width, height),
             rounds=options.rounds,
             max_paths=config.segment.max_paths,
-            colour_split=colour_split_settings(config, width, height),
+            colour_split=colour_split_settings(config, width, height, faint=False),
             gain_tolerance=options.gain_tolerance,
             refit_scene=options.refit_scene,
             marks=MarkSettings(min_pixels=options.filter_speckle**2) if options.marks else None,

@@ -6,9 +6,11 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
+from samvg.config import Config
+from samvg.missing.stage import MissingSettings
 from samvg.segment.colour_split import ColourSplitSettings, colour_parts, lab_image
 from samvg.segment.impact import ImpactCanvas
-from samvg.segment.select import offer_colour_parts, same_colour_groups
+from samvg.segment.select import colour_split_settings, offer_colour_parts, same_colour_groups
 
 SETTINGS = ColourSplitSettings(min_pixels=20)
 RED, WHITE, BLUE = (0.8, 0.1, 0.15), (0.97, 0.95, 0.85), (0.1, 0.2, 0.7)
@@ -147,3 +149,11 @@ def test_same_colour_groups_gather_parts_by_colour() -> None:
     groups = same_colour_groups(lab_parts, lab_image(image), 2.0)
     assert len(groups) == 1 and len(groups[0]) == 2  # the two red ones; blue and white alone
     assert all(np.allclose(image[part], RED) for part in groups[0])
+
+
+def test_stage_4_does_not_split_faint_colours() -> None:
+    stage_1 = colour_split_settings(Config(), 64, 64)
+    stage_4 = MissingSettings.from_config(Config(), 64, 64).colour_split
+    assert stage_1 is not None and stage_4 is not None
+    assert stage_1.fine_contrast < stage_1.contrast
+    assert stage_4.fine_contrast == stage_4.contrast == stage_1.contrast
