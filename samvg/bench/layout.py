@@ -28,6 +28,12 @@ class Layout:
     def target(self, image_id: str) -> Path:
         return self.out / "targets" / f"{image_id}.png"
 
+    def target_features(self, image_id: str) -> Path:
+        return self.out / "fid" / "targets" / f"{image_id}.npy"
+
+    def render_features(self, method: str, image_id: str) -> Path:
+        return self.out / "fid" / "renders" / method / f"{image_id}.npy"
+
     def records(self) -> list[dict[str, Any]]:
         """Every record in the folder, sorted by image id, then method."""
         found = []

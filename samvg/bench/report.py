@@ -15,11 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from samvg.bench.features import FeatureStore, fid_over_stored
 from samvg.bench.layout import Layout
-from samvg.bench.measure import fid_scores
 from samvg.bench.methods import DEFAULT_METHODS
 from samvg.errors import InputError
-from samvg.imaging import to_float_rgb
 from samvg.io import atomic_write_bytes, atomic_write_text, read_image
 
 
@@ -124,21 +123,6 @@ def _markdown_table(
     return lines
 
 
-def _load_float(path: Path) -> np.ndarray:
-    return to_float_rgb(read_image(path), str(path))
-
-
-def _fid_by_method(
-    layout: Layout, methods: list[str], ids: list[str], weights: str | os.PathLike[str] | None
-) -> tuple[dict[str, float], list[str]]:
-    try:
-        targets = [_load_float(layout.target(i)) for i in ids]
-        renders = {m: [_load_float(layout.render(m, i)) for i in ids] for m in methods}
-    except InputError as error:
-        return {m: float("nan") for m in methods}, [f"FID: {error}"]
-    return fid_scores(renders, targets, weights)
-
-
 def _save_figure(figure: Any, path: Path) -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # lazy: optional (bench extra)
 
@@ -196,6 +180,9 @@ def _contact_sheet(
     chosen: list[str] = []
     by_category: dict[str, list[str]] = {}
     for image in ids:
+        pictures = [layout.target(image)] + [layout.render(m, image) for m in methods]
+        if not all(picture.is_file() for picture in pictures):
+            continue  # renders gone (not kept with committed results) or a run stopped part way
         if category[image] not in CONTACT_SKIP_CATEGORIES:
             by_category.setdefault(category[image], []).append(image)
     while len(chosen) < CONTACT_IMAGES and any(by_category.values()):
@@ -243,7 +230,7 @@ def write_report(
     common = _common_ids(records, methods)
     say("FID")
     if fid:
-        fid_values, problems = _fid_by_method(layout, methods, common, fid_weights)
+        fid_values, problems = fid_over_stored(FeatureStore(layout, fid_weights), methods, common)
     else:
         fid_values, problems = {m: float("nan") for m in methods}, ["FID not computed (--no-fid)"]
     overall = _means(records, methods, set(common))

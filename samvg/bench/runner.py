@@ -8,6 +8,8 @@ Layout of the output folder::
     svg/<method>/<id>.svg      each method's SVG
     renders/<method>/<id>.png  its render at the working size (FID, contact sheet)
     targets/<id>.png           the target at the working size
+    fid/targets/<id>.npy       InceptionV3 features of the target (FID; see samvg.bench.features)
+    fid/renders/<method>/<id>.npy   the same of each render
     results.csv, summary.md, *.png   see :mod:`samvg.bench.report`
 """
 
@@ -29,13 +31,14 @@ from typing import Any, Protocol
 import numpy as np
 
 from samvg.baselines import Vectorized, parameter_count, path_count
+from samvg.bench.features import FeatureStore
 from samvg.bench.layout import Layout
 from samvg.bench.manifest import BenchImage, read_manifest
 from samvg.bench.measure import IMAGE_METRICS, Scorer
 from samvg.bench.methods import DEFAULT_METHODS, METHODS, Method, MethodRun
 from samvg.bench.report import write_report
 from samvg.config import Config, FinishOptions
-from samvg.errors import InputError
+from samvg.errors import InputError, WeightsError
 from samvg.imaging import resize_longest, to_float_rgb
 from samvg.io import atomic_write_text, read_image, write_png
 
@@ -259,12 +262,13 @@ def run_bench(
     total = sum(pending(image, method) for image in images for method in planned)
     outcome.skipped = len(images) * len(planned) - total
     scorer = Scorer(lpips_weights) if total else None
+    features = _feature_store(layout, fid_weights) if total and fid else None
     reporter.start(total)
     for image in categories_in_turn(images):
         todo = [method for method in planned if pending(image, method)]
         if todo:
             assert scorer is not None
-            _run_image(image, todo, config, scorer, layout, reporter, outcome)
+            _run_image(image, todo, config, (scorer, features), layout, reporter, outcome)
     if report:
         write_results_csv(layout)
         write_report(layout.out, fid_weights=fid_weights, fid=fid)
@@ -284,11 +288,24 @@ def _open_layout(out: Path, config: Config, command: str | None) -> Layout:
     return layout
 
 
+def _feature_store(layout: Layout, weights: str | os.PathLike[str] | None) -> FeatureStore:
+    """The run's FID feature store, its network loaded now: missing weights stop the run here."""
+    try:
+        return FeatureStore(layout, weights, load_now=True)
+    except WeightsError as error:
+        first = str(error).splitlines()[0]
+        raise WeightsError(f"{first} (or pass --no-fid to run without FID)") from None
+
+
+#: What scores a result: the per-image metrics, and the FID feature store (None without FID).
+Scoring = tuple[Scorer, FeatureStore | None]
+
+
 def _run_image(
     image: BenchImage,
     todo: Sequence[Method],
     config: Config,
-    scorer: Scorer,
+    scoring: Scoring,
     layout: Layout,
     reporter: BenchProgress,
     outcome: BenchOutcome,
@@ -301,6 +318,8 @@ def _run_image(
         if not layout.target(image.id).is_file():
             layout.target(image.id).parent.mkdir(parents=True, exist_ok=True)
             write_png(layout.target(image.id), target)
+        if scoring[1] is not None:
+            scoring[1].save_target(image.id, target)
     except Exception as error:  # one bad image must not stop the run
         target_error = _error_text(error)
     target_complexity = None if target is None else _safe(Scorer.target_complexity, target)
@@ -322,7 +341,7 @@ def _run_image(
                 record["error"] = "no samvg result on this image to take the path count from"
             else:
                 record.update(
-                    _run_one(method, image, target, config, count, scorer, layout, reporter)
+                    _run_one(method, image, target, config, count, scoring, layout, reporter)
                 )
         _write_json(layout.record(method.name, image.id), record)
         write_results_csv(layout)
@@ -346,7 +365,7 @@ def _run_one(
     target: np.ndarray,
     config: Config,
     count: int | None,
-    scorer: Scorer,
+    scoring: Scoring,
     layout: Layout,
     reporter: BenchProgress,
 ) -> dict[str, Any]:
@@ -382,9 +401,14 @@ def _run_one(
             "svg_bytes": len(svg.encode("utf-8")),
             "time_s": round(elapsed, 3),
         }
-        fields.update(scorer.score(render, target))
+        fields.update(scoring[0].score(render, target))
     except Exception as error:  # one failure must not stop the run
         job.details["traceback"] = traceback.format_exc(limit=8)
         return {"status": "error", "error": _error_text(error), "details": job.details}
+    if scoring[1] is not None:
+        try:
+            scoring[1].save_render(method.name, image.id, render)
+        except Exception as error:  # FID then leaves this image out; the result stands
+            job.details["fid_features_error"] = _error_text(error)
     fields["details"] = job.details
     return fields

@@ -2,12 +2,13 @@
 
 import csv
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from samvg import Config, InputError, VectorImage
+from samvg import Config, InputError, VectorImage, WeightsError
 from samvg.baselines import random_init
 from samvg.bench import METHODS, Method, MethodRun, read_manifest, run_bench, write_report
 from samvg.bench.cli import main
@@ -217,6 +218,18 @@ def test_report_in_the_papers_layout(tiny_manifest, tmp_path, lpips_file, fid_fi
     assert "n/a" not in fid_line
     for name in ("time_vs_paths.png", "mse_vs_paths.png", "contact_sheet.png"):
         assert (out / name).stat().st_size > 1000
+    # FID survives the loss of the renders and targets (not kept with committed results)
+    stored = sorted(path.relative_to(out).as_posix() for path in (out / "fid").rglob("*.npy"))
+    assert stored == [
+        f"fid/{kind}/{image}.npy"
+        for kind in ("renders/diffvg", "renders/samvg", "renders/vtracer", "targets")
+        for image in ("cactus", "folder")
+    ]
+    for folder in ("renders", "targets"):
+        shutil.rmtree(out / folder)
+    assert main(["--out", str(out), "--report-only", "--fid-weights", str(fid_file)]) == 0
+    again = (out / "summary.md").read_text()
+    assert next(line for line in again.splitlines() if line.startswith("| FID")) == fid_line
     # the report can be rewritten from the folder alone, by the CLI too (results.csv with it)
     rows = read_rows(out)
     (out / "results.csv").unlink()
@@ -345,3 +358,32 @@ def test_a_missing_optional_module_is_a_one_line_install_hint(tmp_path, capsys, 
         "pip install 'samvg[bench]'"
     ]
     assert not (tmp_path / "out").exists()
+
+
+def test_stored_fid_features_match_a_batched_pass(tmp_path, fid_file, bench_dir):
+    from samvg import metrics
+    from samvg.bench.features import FeatureStore
+    from samvg.bench.layout import Layout
+    from samvg.bench.runner import load_target
+
+    images = [
+        load_target(bench_dir / "emoji" / "noto_cactus.png", 128),
+        load_target(bench_dir / "icon" / "tango_folder_open.png", 128),
+    ]
+    store = FeatureStore(Layout(tmp_path), fid_file)
+    for index, image in enumerate(images):
+        store.save_target(f"image{index}", image)
+    batched = metrics.fid_features(metrics.load_fid_inception(fid_file), images)
+    stored = np.stack([store.target(f"image{index}") for index in range(2)])
+    assert stored.shape == (2, 2048) and np.abs(batched).max() > 0.1
+    np.testing.assert_allclose(stored, batched, rtol=1e-4, atol=1e-5)
+    assert store.target("never_run") is None
+
+
+def test_a_run_without_fid_weights_stops_before_work(tiny_manifest, tmp_path, lpips_file):
+    out = tmp_path / "out"
+    missing = tmp_path / "absent.pt"
+    with pytest.raises(WeightsError, match="pass --no-fid to run without FID"):
+        run_bench(tiny_manifest, out, ["samvg"], method_table=TABLE, lpips_weights=lpips_file,
+                  fid_weights=missing, **TINY)  # fmt: skip
+    assert not (out / "records").exists()
