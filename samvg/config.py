@@ -187,6 +187,10 @@ class FitOptions:
     fill flat, as in the paper)."""
     gradient_cost: float = 1e-6
     """MSE a gradient must remove per parameter it adds over a flat fill."""
+    gradient_ramp: float = 0.25
+    """The least share of its path's extent that a gradient's colour ramp spans (0: free, as
+    Adam leaves it). Keeps gradients as shading: a narrow ramp is an edge drawn by the fill
+    (`samvg.optimize.ramp`)."""
 
     def __post_init__(self) -> None:
         _check_integer(self, "iterations", 0)
@@ -206,8 +210,11 @@ class FitOptions:
             "xing_weight",
             "lpips_weight",
             "gradient_cost",
+            "gradient_ramp",
         ):
             _check_non_negative(self, name)
+        if self.gradient_ramp > 1:
+            raise InputError(f"gradient ramp must be from 0 to 1, got {self.gradient_ramp!r}")
 
     @property
     def wants_lpips(self) -> bool:
@@ -437,6 +444,7 @@ PAPER: dict[str, Any] = {
     "missing_rounds": 1,
     "refit_scene": True,
     "gradients": False,
+    "gradient_ramp": 0.0,
     "coarse_fraction": 0.0,
     "plateau_steps": None,
 }

@@ -62,7 +62,7 @@ RECORD_FIELDS = (
 #: Config fields added after a run may have started, with the value that behaves as samvg did
 #: before they existed: a run file without them holds that value. (The finish pass's options
 #: need no entry: they are compared only where the finish pass runs.)
-_ADDED_SETTINGS: dict[str, Any] = {"lpips_colours": True}
+_ADDED_SETTINGS: dict[str, Any] = {"lpips_colours": True, "gradient_ramp": 0.0}
 #: Config fields that do not change results (paths, device) and so may differ on a rerun.
 _FREE_SETTINGS = ("checkpoint", "lpips_weights", "device")
 

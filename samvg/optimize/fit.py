@@ -18,6 +18,7 @@ from samvg.imaging import halve
 from samvg.optimize.adam import Adam
 from samvg.optimize.losses import PerceptualLoss, lpips_loss, segment_indices, xing_loss
 from samvg.optimize.paint_choice import choose_gradients
+from samvg.optimize.ramp import widen_ramps
 from samvg.render import rasterize
 from samvg.render._paint_kernels import MAX_STOPS, RADIAL
 from samvg.render.rasterizer import GradientPaints
@@ -75,6 +76,9 @@ class FitSettings:
     """Offer every flat path, and a flat background, a gradient fill before fitting
     (`samvg.optimize.paint_choice`), bought when it removes this much MSE per added parameter;
     None: fills stay as they are."""
+    gradient_ramp: float = 0.0
+    """The least share of its path's extent that a gradient's colour ramp spans after every
+    step (`samvg.optimize.ramp`; 0: free)."""
 
     @classmethod
     def from_options(
@@ -108,6 +112,7 @@ class FitSettings:
             coarse_perceptual=options.coarse_lpips,
             plateau_steps=options.plateau_steps,
             gradient_cost=options.gradient_cost if options.gradients else None,
+            gradient_ramp=options.gradient_ramp,
             draft_steps=min(options.draft_iterations, options.iterations),
         )
 
@@ -195,15 +200,25 @@ class _GradientVariables:
         return GradientPaints(self.kinds, self.stops, torch.cat([self.geometry, self.values], 1))
 
     @torch.no_grad()
-    def project(self) -> None:
-        """Stop colours into [0, 1], offsets non-decreasing in [0, 1], radii at least 0.5 px."""
+    def project(self, points: np.ndarray, offsets: np.ndarray, ramp: float) -> None:
+        """Stop colours into [0, 1], offsets non-decreasing in [0, 1], radii at least 0.5 px,
+        ramps at least ``ramp`` of their path's extent (`widen_ramps`; the paths' control
+        points ``points`` packed by ``offsets``)."""
         self.values.clamp_(0.0, 1.0)
-        offsets = self.values[:, :MAX_STOPS]
-        offsets.copy_(torch.cummax(offsets, dim=1).values)
+        stop_offsets = self.values[:, :MAX_STOPS]
+        stop_offsets.copy_(torch.cummax(stop_offsets, dim=1).values)
         radial = torch.from_numpy(self.kinds == RADIAL)
         self.geometry[radial, 2] = self.geometry[radial, 2].clamp(min=0.5)
         if not bool(torch.isfinite(self.geometry).all()):
             raise SamvgError(_DIVERGED)
+        if ramp > 0:
+            params = torch.cat([self.geometry, self.values], 1).numpy().astype(np.float64)
+            changed = widen_ramps(self.kinds, self.stops, params, points, offsets, ramp)
+            if changed.any():
+                rows = torch.from_numpy(changed)
+                widened = torch.from_numpy(params[changed]).to(self.geometry.dtype)
+                self.geometry[rows] = widened[:, :4]
+                self.values[rows] = widened[:, 4:]
 
     def paints(self, colours: np.ndarray) -> tuple[Paint, ...]:
         return self.current().paints(colours)
@@ -280,9 +295,13 @@ class _Parameters:
     @torch.no_grad()
     def project(self, settings: FitSettings) -> None:
         _project(self.points, self.colours, settings)
-        for variables in (self.gradients, self.background):
-            if variables is not None:
-                variables.project()
+        if self.gradients is not None:
+            points = self.points.detach().numpy()
+            self.gradients.project(points, self.scene.offsets, settings.gradient_ramp)
+        if self.background is not None:
+            width, height = self.scene.width, self.scene.height
+            corners = np.array([[0.0, 0.0], [width, 0.0], [0.0, height], [width, height]])
+            self.background.project(corners, np.array([0, 4]), settings.gradient_ramp)
 
     def fitted(self) -> Scene:
         points = self.points.detach().numpy().astype(np.float64)
