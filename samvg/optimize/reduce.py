@@ -33,13 +33,22 @@ WINDOW_PAD = 2
 
 def removal_costs(scene: Scene, target: np.ndarray) -> np.ndarray:
     """For each path, how much the image's MSE rises when that path alone is removed (can be
-    negative: the path does harm)."""
-    squared = np.sum((scene.render() - target) ** 2)
-    costs = np.empty(scene.path_count)
+    negative: the path does harm), rendered on the path's window alone (see `window_change`)."""
+    picture = scene.render()
+    boxes = scene.path_boxes()
+    kept = np.ones(scene.path_count, dtype=bool)
+    costs = np.zeros(scene.path_count)
     for index in range(scene.path_count):
-        others = [other for other in range(scene.path_count) if other != index]
-        without = scene.subset(others).render()
-        costs[index] = np.sum((without - target) ** 2) - squared
+        found = _path_window(scene, boxes, kept, index, None)
+        if found is None:
+            continue  # nothing of it on the canvas
+        window, local, origin = found
+        x0, y0 = int(origin[0]), int(origin[1])
+        rows, columns = slice(y0, y0 + window.height), slice(x0, x0 + window.width)
+        without = window.subset(np.flatnonzero(np.arange(window.path_count) != local)).render()
+        costs[index] = np.sum((without - target[rows, columns]) ** 2) - np.sum(
+            (picture[rows, columns] - target[rows, columns]) ** 2
+        )
     return costs / target.size
 
 

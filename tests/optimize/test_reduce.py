@@ -195,3 +195,23 @@ def test_smallest_changes_first_calls_a_lazy_budget_only_when_needed():
     assert calls == []  # nothing under the tolerance: the budget (a full render) never measured
     count, left = smallest_changes_first(2, lambda i: 0.25, lambda i: None, 1.0, budget)
     assert calls == [1] and count == 2 and left == pytest.approx(0.2)
+
+
+def test_removal_costs_on_windows_equal_those_of_whole_renders(bench_dir):
+    """On a real image (24 fitted random paths, overlapping, as the DiffVG baseline starts) the
+    windowed costs are the whole-canvas ones: a path changes no pixel outside its padded
+    control-point box."""
+    from samvg.baselines import random_init
+    from samvg.bench.runner import load_target
+
+    target = load_target(bench_dir / "emoji" / "fluentflat_crab.png", 128)
+    scene = random_init(target, 24, steps=5, seed=3)
+    picture = scene.render()
+    base = np.sum((picture - target) ** 2)
+    whole = np.array([
+        np.sum((scene.subset([o for o in range(24) if o != i]).render() - target) ** 2) - base
+        for i in range(24)
+    ]) / target.size  # fmt: skip
+    windowed = removal_costs(scene, target)
+    assert np.abs(whole).max() > 1e-4
+    np.testing.assert_allclose(windowed, whole, rtol=1e-4, atol=1e-9)
