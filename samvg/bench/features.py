@@ -111,12 +111,13 @@ def fid_over_stored(
     try:
         for image_id in ids:
             target = store.target(image_id)
-            own = {method: store.render(method, image_id) for method in methods}
-            if target is None or any(features is None for features in own.values()):
+            found = [store.render(method, image_id) for method in methods]
+            own = [features for features in found if features is not None]
+            if target is None or len(own) < len(methods):
                 continue
             targets.append(target)
-            for method in methods:
-                renders[method].append(own[method])  # type: ignore[arg-type]
+            for method, features in zip(methods, own, strict=True):
+                renders[method].append(features)
     except SamvgError as error:
         return values, [f"FID: {str(error).splitlines()[0]}"]
     problems = []

@@ -26,7 +26,7 @@ import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
@@ -268,7 +268,7 @@ def run_bench(
         todo = [method for method in planned if pending(image, method)]
         if todo:
             assert scorer is not None
-            _run_image(image, todo, config, (scorer, features), layout, reporter, outcome)
+            _run_image(image, todo, config, Scoring(scorer, features), layout, reporter, outcome)
     if report:
         write_results_csv(layout)
         write_report(layout.out, fid_weights=fid_weights, fid=fid)
@@ -297,8 +297,12 @@ def _feature_store(layout: Layout, weights: str | os.PathLike[str] | None) -> Fe
         raise WeightsError(f"{first} (or pass --no-fid to run without FID)") from None
 
 
-#: What scores a result: the per-image metrics, and the FID feature store (None without FID).
-Scoring = tuple[Scorer, FeatureStore | None]
+class Scoring(NamedTuple):
+    """What scores a result: the per-image metrics, and the FID feature store (None without
+    FID)."""
+
+    scorer: Scorer
+    features: FeatureStore | None
 
 
 def _run_image(
@@ -318,8 +322,8 @@ def _run_image(
         if not layout.target(image.id).is_file():
             layout.target(image.id).parent.mkdir(parents=True, exist_ok=True)
             write_png(layout.target(image.id), target)
-        if scoring[1] is not None:
-            scoring[1].save_target(image.id, target)
+        if scoring.features is not None:
+            scoring.features.save_target(image.id, target)
     except Exception as error:  # one bad image must not stop the run
         target_error = _error_text(error)
     target_complexity = None if target is None else _safe(Scorer.target_complexity, target)
@@ -401,13 +405,13 @@ def _run_one(
             "svg_bytes": len(svg.encode("utf-8")),
             "time_s": round(elapsed, 3),
         }
-        fields.update(scoring[0].score(render, target))
+        fields.update(scoring.scorer.score(render, target))
     except Exception as error:  # one failure must not stop the run
         job.details["traceback"] = traceback.format_exc(limit=8)
         return {"status": "error", "error": _error_text(error), "details": job.details}
-    if scoring[1] is not None:
+    if scoring.features is not None:
         try:
-            scoring[1].save_render(method.name, image.id, render)
+            scoring.features.save_render(method.name, image.id, render)
         except Exception as error:  # FID then leaves this image out; the result stands
             job.details["fid_features_error"] = _error_text(error)
     fields["details"] = job.details

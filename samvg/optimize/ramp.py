@@ -17,9 +17,6 @@ import numpy as np
 
 from samvg.render._paint_kernels import FLAT, LINEAR
 
-#: The default share of a path's extent that its gradient's ramp must span.
-DEFAULT_RAMP = 0.25
-
 
 def widen_ramps(
     kinds: np.ndarray,
