@@ -171,6 +171,11 @@ def _scatter(
     _save_figure(figure, path)
 
 
+def _pictures(layout: Layout, methods: list[str], image: str) -> list[Path]:
+    """The target's PNG, then each method's render of ``image``: one row of the contact sheet."""
+    return [layout.target(image)] + [layout.render(method, image) for method in methods]
+
+
 def _contact_sheet(
     layout: Layout, records: list[dict[str, Any]], methods: list[str], ids: list[str], path: Path
 ) -> None:
@@ -180,8 +185,7 @@ def _contact_sheet(
     chosen: list[str] = []
     by_category: dict[str, list[str]] = {}
     for image in ids:
-        pictures = [layout.target(image)] + [layout.render(m, image) for m in methods]
-        if not all(picture.is_file() for picture in pictures):
+        if not all(picture.is_file() for picture in _pictures(layout, methods, image)):
             continue  # renders gone (not kept with committed results) or a run stopped part way
         if category[image] not in CONTACT_SKIP_CATEGORIES:
             by_category.setdefault(category[image], []).append(image)
@@ -194,7 +198,7 @@ def _contact_sheet(
     columns = ["target", *methods]
     figure = Figure(figsize=(2.2 * len(columns), 2.3 * len(chosen)))
     for row, image in enumerate(chosen):
-        pictures = [layout.target(image)] + [layout.render(m, image) for m in methods]
+        pictures = _pictures(layout, methods, image)
         by_id = {r["method"]: r for r in records if r["id"] == image}
         for column, (name, picture) in enumerate(zip(columns, pictures, strict=True)):
             axes = figure.add_subplot(len(chosen), len(columns), row * len(columns) + column + 1)
