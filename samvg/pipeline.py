@@ -8,7 +8,6 @@ Each stage owns its settings: they are derived here once from `Config`, in worki
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import time
 from collections.abc import Callable, Iterator
@@ -34,7 +33,7 @@ from samvg.imaging import alpha_channel, resize_longest, to_float_rgb, to_rgb_ui
 from samvg.io import read_image_with_alpha
 from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
 from samvg.missing import MissingSettings
-from samvg.missing.stage import BUDGET_POOL, MAX_AUTO_ROUNDS, add_missing_rounds
+from samvg.missing.stage import MAX_AUTO_ROUNDS, add_missing_rounds, budget_pool
 from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import margin_box
 from samvg.optimize.reduce import (
@@ -386,7 +385,7 @@ def _add_missing(
     (under a budget it is not: the fit after the cut does it). ``drafted``: stage 3's fit was a
     draft, so the scene is fitted in full even when no round adds a path."""
     budget = config.missing.paths
-    pool = math.ceil(BUDGET_POOL * budget) if budget is not None else None
+    pool = budget_pool(budget, scene.path_count) if budget is not None else None
     planned = settings[0].rounds
     total = planned if planned is not None else MAX_AUTO_ROUNDS
     report("missing", 0, total)

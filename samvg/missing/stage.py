@@ -5,6 +5,7 @@ a round gains less than the detail tolerance, or until a path budget's pool is f
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -28,11 +29,22 @@ MAX_AUTO_ROUNDS = 6
 #: A path budget's pool: stage 4 grows the scene to this many times the budget before the
 #: paths of least impact are removed.
 BUDGET_POOL = 1.25
+#: Under a budget, stage 4 may add this share of the budget even to a scene that stages 1-3
+#: already grew past the pool: there the grid's colour parts (a wall's texture) fill the pool
+#: first, and parts that no grid point found (kodim01's shutters at 64 paths) were never offered.
+BUDGET_GROWTH = 0.25
 #: Under a budget, a round that finds nothing halves stage 4's error bars (the prompts' ω and
 #: the marks' error; see `eased_settings`) and tries again, at most this many times: the budget is
 #: filled from the largest errors left, as LIVE fills it, before the scene is declared done. A
 #: round at eased bars keeps its paths only if they lower the error by ``gain_tolerance``.
 BUDGET_EASINGS = 3
+
+
+def budget_pool(budget: int, paths: int) -> int:
+    """How many paths stage 4 may grow a scene of ``paths`` paths to under a path budget: the
+    budget's pool (`BUDGET_POOL` × the budget), or ``paths`` plus `BUDGET_GROWTH` × the budget
+    where that is more."""
+    return max(math.ceil(BUDGET_POOL * budget), paths + math.ceil(BUDGET_GROWTH * budget))
 
 
 @dataclass(frozen=True)

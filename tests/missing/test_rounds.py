@@ -9,6 +9,7 @@ from samvg.missing.marks import MarkSettings
 from samvg.missing.stage import (
     MissingSettings,
     add_missing_rounds,
+    budget_pool,
     eased_settings,
     offer_wrong_regions,
 )
@@ -180,3 +181,13 @@ def test_eased_settings_halve_the_prompts_and_marks_error_bars():
     assert eased.threshold == 0.25 and eased.pixel_error == settings().pixel_error
     assert eased.marks is not None and eased.marks.pixel_error == 0.075
     assert eased.impact_threshold == settings().impact_threshold
+
+
+def test_a_budget_pool_leaves_room_to_grow_a_scene_that_already_fills_it():
+    assert budget_pool(64, 10) == 80  # the pool itself: 1.25 x the budget
+    assert budget_pool(64, 133) == 149  # stages 1-3 gave more: a quarter of the budget on top
+    assert budget_pool(16, 75) == 79
+    # a budget of 1 whose scene has 2 paths already: stage 4 may still add one (of 3 regions)
+    full = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), STAGES, pool=2).scene
+    done = add_missing_rounds(full, target(), SilentSegmenter(), STAGES, pool=budget_pool(1, 2))
+    assert done.added == 1 and done.scene.path_count == 3
