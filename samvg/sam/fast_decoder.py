@@ -60,6 +60,15 @@ def _center(x: torch.Tensor, dim: int = -1) -> torch.Tensor:
     return x - x.mean(dim, keepdim=True)
 
 
+def _weighted_sum(x: torch.Tensor, w: torch.Tensor) -> torch.Tensor:
+    """``(x * w).sum`` over the low-rank axis: x (B, H, T, N) (any strides), w (B, H*T, N)
+    -> (B, N). The product goes into a contiguous buffer first: torch's sum over two strided
+    axes of a transposed view is several times slower than over one contiguous middle axis."""
+    b, h, t, n = x.shape
+    prod = torch.mul(x, w.view(b, h, t, n), out=torch.empty((b, h, t, n), dtype=x.dtype))
+    return prod.view(b, h * t, n).sum(1)
+
+
 def _logit_scale(att: Attention) -> float:
     """The attention's logit scale, 1 / sqrt(head dimension)."""
     return 1.0 / math.sqrt(att.internal_dim // att.num_heads)
@@ -276,7 +285,7 @@ class FastDecoder:
         a1 = torch.softmax(lg.transpose(0, 1), dim=2).reshape(b, ht, n)
         # LayerNorm statistics of x1 = Y1 + A1 U1
         cross = torch.matmul(vt1.transpose(0, 1).reshape(h, b * t, -1), self.e1t)
-        cross = cross.view(h, b, t, n).transpose(0, 1).mul_(a1.view(b, h, t, n)).sum((1, 2))
+        cross = _weighted_sum(cross.view(h, b, t, n).transpose(0, 1), a1)
         u1 = _factor(vt1, self.m1c)  # (B, HT, C) centred rows of U1
         g = torch.bmm(u1, u1.transpose(1, 2))
         quad = torch.bmm(g, a1).mul_(a1).sum(1)
@@ -334,8 +343,8 @@ class FastDecoder:
         d = torch.cat([a1 * s1[:, None, :], a2, torch.ones_like(a2[:, :1])], dim=1)
         vt12 = torch.cat([vt1, vt2], dim=1)  # (B, 2H, T, d)
         cross = torch.matmul(vt12.transpose(0, 1).reshape(2 * h, b * t, -1), self.e2t)
-        cross = cross.view(2 * h, b, t, n).transpose(0, 1).mul_(d[:, : 2 * ht].view(b, 2 * h, t, n))
-        cross = cross.sum((1, 2)) + self.y_cc
+        cross = _weighted_sum(cross.view(2 * h, b, t, n).transpose(0, 1), d[:, : 2 * ht])
+        cross += self.y_cc
         r = torch.cat([_factor(vt12, self.basis), self.cc.expand(b, 1, -1)], dim=1)  # (B, 2HT+1, C)
         g = torch.bmm(r, r.transpose(1, 2))
         quad = torch.bmm(g, d).mul_(d).sum(1)
