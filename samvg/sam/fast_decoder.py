@@ -65,7 +65,7 @@ def _weighted_sum(x: torch.Tensor, w: torch.Tensor) -> torch.Tensor:
     -> (B, N). The product goes into a contiguous buffer first: torch's sum over two strided
     axes of a transposed view is several times slower than over one contiguous middle axis."""
     b, h, t, n = x.shape
-    prod = torch.mul(x, w.view(b, h, t, n), out=torch.empty((b, h, t, n), dtype=x.dtype))
+    prod = torch.mul(x, w.view(b, h, t, n), out=x.new_empty((b, h, t, n)))
     return prod.view(b, h * t, n).sum(1)
 
 
