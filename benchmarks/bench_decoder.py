@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import math
 import statistics
 import time
 from pathlib import Path
@@ -26,18 +25,15 @@ from typing import Any
 
 import numpy as np
 import torch
-from PIL import Image
+from bench_images import BENCH, REPO, bench_entries
 
 import samvg.sam.predictor as predictor_module
+from samvg.io import read_image
 from samvg.sam import SamAutomaticMaskGenerator, SamPredictor, load_sam
-from samvg.sam.amg_utils import build_all_layer_point_grids
 from samvg.sam.fast_decoder import FastDecoder
-from samvg.sam.predictor import needed_lowres
+from samvg.sam.predictor import decoder_grids
 
-ROOT = Path(__file__).resolve().parents[1]
-SHARED = ROOT.parent / "shared"
-POINTS_PER_BATCH = 8
-MASK_BATCH = 2
+GRID_SIDE = 32
 
 
 def load_old_decoder(tree: Path) -> type:
@@ -52,42 +48,59 @@ def load_old_decoder(tree: Path) -> type:
     return module.FastDecoder
 
 
-def bench_image_path(image_id: str) -> Path:
-    found = sorted((SHARED / "bench").glob(f"*/{image_id}.png"))
-    if not found:
-        raise SystemExit(f"no bench image {image_id!r} under {SHARED / 'bench'}")
-    return found[0]
+def bench_image(image_id: str) -> np.ndarray:
+    """A bench image by id, as uint8 RGB, the way the product reads it."""
+    for entry in bench_entries():
+        if entry["id"] == image_id:
+            return read_image(BENCH / entry["png"])
+    raise SystemExit(f"no bench image {image_id!r} in {BENCH / 'manifest.csv'}")
 
 
 def prompt_batches(
-    model: Any, predictor: SamPredictor, height: int, width: int
+    generator: SamAutomaticMaskGenerator, predictor: SamPredictor, height: int, width: int
 ) -> list[torch.Tensor]:
-    """Sparse prompt embeddings of the generator's 32x32 grid, in its batches."""
-    points = build_all_layer_point_grids(32, 0, 1)[0] * np.array([[width, height]])
+    """Sparse prompt embeddings of the generator's whole-image grid, in its batches."""
+    points = generator.point_grids[0] * np.array([[width, height]])
+    step = generator.points_per_batch
     batches = []
     with torch.inference_mode():
-        for start in range(0, len(points), POINTS_PER_BATCH):
-            chunk = torch.as_tensor(points[start : start + POINTS_PER_BATCH], dtype=torch.float32)
+        for start in range(0, len(points), step):
+            chunk = torch.as_tensor(points[start : start + step], dtype=torch.float32)
             coords = predictor.transform_coords(chunk)[:, None, :]
-            sparse, _ = model.prompt_encoder((coords, torch.ones(len(chunk), 1)), None, None)
+            sparse, _ = generator.model.prompt_encoder(
+                (coords, torch.ones(len(chunk), 1)), None, None
+            )
             batches.append(sparse)
     return batches
 
 
 def time_decoder(
-    decoder: Any, batches: list[torch.Tensor], with_masks: bool, grids: tuple
+    decoder: Any,
+    batches: list[torch.Tensor],
+    with_masks: bool,
+    generator: SamAutomaticMaskGenerator,
+    input_size: tuple[int, int],
 ) -> float:
-    grid_hw, valid_hw = grids
+    """Seconds for all ``batches`` through the transformer (and, ``with_masks``, every prompt's
+    three masks and stability counts, in the generator's mask batches and thresholds)."""
+    grid_hw, valid_hw = decoder_grids(input_size)
+    threshold, offset = generator.model.mask_threshold, generator.stability_score_offset
+    step = generator.mask_batch
     start = time.perf_counter()
     with torch.inference_mode():
         for sparse in batches:
             state = decoder.transformer(sparse)
             if not with_masks:
                 continue
-            for first in range(0, len(sparse), MASK_BATCH):
-                chosen = torch.arange(first, min(first + MASK_BATCH, len(sparse)))
+            for first in range(0, len(sparse), step):
+                chosen = torch.arange(first, min(first + step, len(sparse)))
                 decoder.masks_and_counts(
-                    state.select(chosen), [1, 2, 3], grid_hw, valid_hw, 1.0, -1.0
+                    state.select(chosen),
+                    [1, 2, 3],
+                    grid_hw,
+                    valid_hw,
+                    threshold + offset,
+                    threshold - offset,
                 )
     return time.perf_counter() - start
 
@@ -97,7 +110,7 @@ def amg_masks(model: Any, image: np.ndarray, decoder_class: type) -> np.ndarray:
     saved = predictor_module.FastDecoder
     predictor_module.FastDecoder = decoder_class  # type: ignore[assignment,misc]
     try:
-        found = SamAutomaticMaskGenerator(model, points_per_side=32).generate(image)
+        found = SamAutomaticMaskGenerator(model, points_per_side=GRID_SIDE).generate(image)
     finally:
         predictor_module.FastDecoder = saved  # type: ignore[misc]
     return (
@@ -108,27 +121,23 @@ def amg_masks(model: Any, image: np.ndarray, decoder_class: type) -> np.ndarray:
 
 
 def measure(image_id: str, model: Any, old_class: type, repeat: int) -> dict[str, Any]:
-    image = np.asarray(Image.open(bench_image_path(image_id)).convert("RGB")).copy()
+    image = bench_image(image_id)
+    generator = SamAutomaticMaskGenerator(model, points_per_side=GRID_SIDE)
     predictor = SamPredictor(model, fast=True)
     start = time.perf_counter()
     predictor.set_image(image)
     encoder_s = time.perf_counter() - start
     embedding = predictor.get_image_embedding()
     decoders = {"old": old_class(model, embedding), "new": FastDecoder(model, embedding)}
-    assert predictor.input_size is not None
-    low_h, low_w = needed_lowres(predictor.input_size)
-    in_h, in_w = predictor.input_size
-    grids = (
-        (math.ceil(low_h / 4), math.ceil(low_w / 4)),
-        (math.ceil(in_h / 4), math.ceil(in_w / 4)),
-    )
-    batches = prompt_batches(model, predictor, *image.shape[:2])
+    input_size = predictor.input_size
+    assert input_size is not None
+    batches = prompt_batches(generator, predictor, *image.shape[:2])
     runs: dict[tuple[str, str], list[float]] = {}
     for _ in range(repeat):
         for part, with_masks in (("transformer", False), ("transformer+masks", True)):
             for name, decoder in decoders.items():
                 runs.setdefault((name, part), []).append(
-                    time_decoder(decoder, batches, with_masks, grids)
+                    time_decoder(decoder, batches, with_masks, generator, input_size)
                 )
     old_masks, new_masks = amg_masks(model, image, old_class), amg_masks(model, image, FastDecoder)
     same = old_masks.shape == new_masks.shape and bool((old_masks == new_masks).all())
@@ -180,7 +189,7 @@ def main() -> None:
         "--images", nargs="+", default=["kodim04", "kodim05", "fluentflat_hamburger"]
     )
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "decoder.md")
+    parser.add_argument("--out", type=Path, default=REPO / "benchmarks" / "results" / "decoder.md")
     args = parser.parse_args()
     torch.set_num_threads(max(1, min(2, torch.get_num_threads())))
     old_class = load_old_decoder(args.old_tree)

@@ -25,7 +25,7 @@ from samvg.sam.amg_utils import (
 )
 from samvg.sam.image import to_rgb_uint8
 from samvg.sam.model import Sam
-from samvg.sam.predictor import SamPredictor, needed_lowres, resize_logits
+from samvg.sam.predictor import SamPredictor, decoder_grids, needed_lowres, resize_logits
 
 #: RGB distance (0-255) within which a grid point has the colour of the mask that covers it
 #: (24 in the 24-image run of `benchmarks/results/speed.md`; 12 kept all of debian_emerald's
@@ -165,8 +165,7 @@ class SamAutomaticMaskGenerator:
         assert pred.input_size is not None
         in_h, in_w = pred.input_size
         lh, lw = needed_lowres(pred.input_size)
-        grid_hw = (math.ceil(lh / 4), math.ceil(lw / 4))
-        vh, vw = math.ceil(in_h / 4), math.ceil(in_w / 4)  # low-res cells covering the image
+        grid_hw, valid_hw = decoder_grids(pred.input_size)
         points = self.point_grids[layer] * np.array([[cw, ch]])
         mask_ids = [1, 2, 3]
         thr = self.model.mask_threshold
@@ -196,7 +195,7 @@ class SamAutomaticMaskGenerator:
                 sel = prompt_idx[j : j + self.mask_batch]
                 off = self.stability_score_offset
                 low, cnt = fd.masks_and_counts(  # (b, 3, 4gh, 4gw) logits, (b, 3, 2) counts
-                    st.select(sel), mask_ids, grid_hw, (vh, vw), thr + off, thr - off
+                    st.select(sel), mask_ids, grid_hw, valid_hw, thr + off, thr - off
                 )
                 stab = stability_from_counts(cnt[..., 0], cnt[..., 1])
                 keep = ok[sel]

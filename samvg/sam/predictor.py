@@ -57,6 +57,16 @@ def needed_lowres(input_size: tuple[int, int], grid: int = 256) -> tuple[int, in
     )
 
 
+def decoder_grids(input_size: tuple[int, int]) -> tuple[tuple[int, int], tuple[int, int]]:
+    """The 64x64 token grid's part that `FastDecoder.masks_and_counts` lays out for this input
+    size (enough 4x4 cells for `needed_lowres`), and the part whose cells cover the image (the
+    rest is padding): its ``grid_hw`` and ``valid_hw``."""
+    low_h, low_w = needed_lowres(input_size)
+    grid_hw = (math.ceil(low_h / 4), math.ceil(low_w / 4))
+    valid_hw = (math.ceil(input_size[0] / 4), math.ceil(input_size[1] / 4))
+    return grid_hw, valid_hw
+
+
 def _as_float_array(x: npt.ArrayLike, shape_tail: tuple[int, ...], what: str) -> np.ndarray:
     arr = np.asarray(x, dtype=np.float64)
     if arr.ndim != len(shape_tail) + 1 or arr.shape[1:] != shape_tail:
