@@ -1,7 +1,8 @@
 """Remove paths by their measured worth: reduce a scene to a path budget, removing the paths
 whose removal raises the error least, a batch at a time and measuring again after each batch
 (the top-down step of Optimize & Reduce, Hirschorn et al., AAAI 2024; the caller fits the
-reduced scene again), and remove the idle paths of any scene, those whose removal changes the
+reduced scene again) and, within a batch, measuring again a path that overlaps one already
+chosen, and remove the idle paths of any scene, those whose removal changes the
 picture by less than a tolerance (a path painted over the same colour, a sliver under a
 neighbour's edge); likewise make idle gradient fills flat (a gradient mostly covered by the
 paths above it, or one that barely changes over what shows).
@@ -12,6 +13,7 @@ in time that follows the path's size rather than the canvas's."""
 
 from __future__ import annotations
 
+import heapq
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -37,18 +39,12 @@ def removal_costs(scene: Scene, target: np.ndarray) -> np.ndarray:
     picture = scene.render()
     boxes = scene.path_boxes()
     kept = np.ones(scene.path_count, dtype=bool)
-    costs = np.zeros(scene.path_count)
-    for index in range(scene.path_count):
-        found = _path_window(scene, boxes, kept, index, None)
-        if found is None:
-            continue  # nothing of it on the canvas
-        window, local, origin = found
-        x0, y0 = int(origin[0]), int(origin[1])
-        rows, columns = slice(y0, y0 + window.height), slice(x0, x0 + window.width)
-        without = window.subset(np.flatnonzero(np.arange(window.path_count) != local)).render()
-        costs[index] = np.sum((without - target[rows, columns]) ** 2) - np.sum(
-            (picture[rows, columns] - target[rows, columns]) ** 2
-        )
+    costs = np.array(
+        [
+            _removal_cost(scene, boxes, kept, index, target, picture)
+            for index in range(scene.path_count)
+        ]
+    )
     return costs / target.size
 
 
@@ -59,11 +55,71 @@ def reduce_paths(scene: Scene, target: np.ndarray, count: int) -> tuple[Scene, i
     while scene.path_count > count:
         excess = scene.path_count - count
         batch = max(1, excess // 2) if excess > 4 else excess
-        costs = removal_costs(scene, target)
-        dropped = set(np.argsort(costs, kind="stable")[:batch].tolist())
+        dropped = set(cheapest_together(scene, target, removal_costs(scene, target), batch))
         scene = scene.subset([index for index in range(scene.path_count) if index not in dropped])
         removed += batch
     return scene, removed
+
+
+def cheapest_together(scene: Scene, target: np.ndarray, costs: np.ndarray, batch: int) -> list[int]:
+    """``batch`` paths to remove together, cheapest first by ``costs`` (`removal_costs`), where a
+    path that overlaps one already chosen is measured again with the chosen ones gone before it
+    may join: two overlapping paths that each hide the other's loss (a leg drawn twice) each
+    cost little alone, and much together. The lazy greedy step: a path far from every chosen
+    one keeps its cost, as removing it changes no pixel another removal changes."""
+    boxes = scene.path_boxes()
+    reach = boxes + np.array([-WINDOW_PAD, -WINDOW_PAD, WINDOW_PAD, WINDOW_PAD])
+    kept = np.ones(scene.path_count, dtype=bool)
+    queue = [(float(cost), index, 0) for index, cost in enumerate(costs)]
+    heapq.heapify(queue)
+    chosen: list[int] = []
+    while queue and len(chosen) < batch:
+        cost, index, measured_with = heapq.heappop(queue)
+        since = reach[chosen[measured_with:]]
+        if len(since) and _overlapping(reach[index], since):
+            again = _removal_cost(scene, boxes, kept, index, target) / target.size
+            heapq.heappush(queue, (again, index, len(chosen)))
+            continue
+        chosen.append(index)
+        kept[index] = False
+    return chosen
+
+
+def _overlapping(box: np.ndarray, others: np.ndarray) -> bool:
+    """Whether ``box`` (x0, y0, x1, y1) meets any of ``others`` (N, 4)."""
+    return bool(
+        np.any(
+            (others[:, 0] < box[2])
+            & (others[:, 2] > box[0])
+            & (others[:, 1] < box[3])
+            & (others[:, 3] > box[1])
+        )
+    )
+
+
+def _removal_cost(
+    scene: Scene,
+    boxes: np.ndarray,
+    kept: np.ndarray,
+    index: int,
+    target: np.ndarray,
+    picture: np.ndarray | None = None,
+) -> float:
+    """How much the squared error against ``target`` (summed) rises when path ``index`` goes
+    from the paths ``kept``, on its window; ``picture`` is the kept paths' whole render where
+    known (else the window is rendered with the path as well)."""
+    found = _path_window(scene, boxes, kept, index, None)
+    if found is None:
+        return 0.0  # nothing of it on the canvas
+    window, local, origin = found
+    x0, y0 = int(origin[0]), int(origin[1])
+    rows, columns = slice(y0, y0 + window.height), slice(x0, x0 + window.width)
+    with_path = picture[rows, columns] if picture is not None else window.render()
+    without = window.subset(np.flatnonzero(np.arange(window.path_count) != local)).render()
+    return float(
+        np.sum((without - target[rows, columns]) ** 2)
+        - np.sum((with_path - target[rows, columns]) ** 2)
+    )
 
 
 def _path_window(

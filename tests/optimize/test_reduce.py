@@ -8,6 +8,7 @@ import pytest
 from samvg.optimize.reduce import (
     IDLE_COST,
     IDLE_SHARE,
+    cheapest_together,
     flatten_idle_gradients,
     reduce_paths,
     removal_costs,
@@ -59,6 +60,25 @@ def test_reduce_paths_keeps_the_paths_that_matter_in_paint_order():
     assert np.array_equal(reduced.points, scene.subset([1, 2]).points)
     assert np.allclose(reduced.render(), target)
     assert reduce_paths(scene, target, 10)[0].path_count == 4  # under budget: unchanged
+
+
+def test_a_path_drawn_twice_loses_one_copy_not_both():
+    """Each copy of the red square costs nothing alone; removed together they cost the square.
+    With two paths to remove from three, one copy and the small blue square go."""
+    paths = [(square(8, 8, 20), RED), (square(8, 8, 20), RED), (square(44, 44, 6), BLUE)]
+    scene = Scene.from_paths(64, 64, paths, background=(1.0, 1.0, 1.0))
+    target = scene.render()
+    costs = removal_costs(scene, target)
+    assert costs[0] == costs[1] == 0.0 < costs[2]
+    assert sorted(cheapest_together(scene, target, costs, 2)) == [0, 2]
+    reduced, removed = reduce_paths(scene, target, 1)
+    assert removed == 2 and np.array_equal(reduced.points, scene.subset([1]).points)
+
+
+def test_far_apart_paths_are_chosen_by_their_first_costs_alone():
+    scene, target = scene_and_target()
+    costs = removal_costs(scene, target)
+    assert cheapest_together(scene, target, costs, 2) == list(np.argsort(costs, kind="stable")[:2])
 
 
 def test_window_changes_equal_whole_canvas_changes():
