@@ -115,11 +115,16 @@ def _removal_cost(
     x0, y0 = int(origin[0]), int(origin[1])
     rows, columns = slice(y0, y0 + window.height), slice(x0, x0 + window.width)
     with_path = picture[rows, columns] if picture is not None else window.render()
-    without = window.subset(np.flatnonzero(np.arange(window.path_count) != local)).render()
+    without = _without(window, local).render()
     return float(
         np.sum((without - target[rows, columns]) ** 2)
         - np.sum((with_path - target[rows, columns]) ** 2)
     )
+
+
+def _without(window: Scene, local: int) -> Scene:
+    """``window`` without its path ``local``."""
+    return window.subset(np.flatnonzero(np.arange(window.path_count) != local))
 
 
 def _path_window(
@@ -168,7 +173,7 @@ def window_change(
         return 0.0  # nothing of it on the canvas
     window, local, origin = found
     if replacement is None:
-        changed = window.subset(np.flatnonzero(np.arange(window.path_count) != local))
+        changed = _without(window, local)
     else:
         points = window.points.copy()
         points[window.offsets[local] : window.offsets[local + 1]] = replacement - origin
