@@ -216,7 +216,7 @@ def write_report(out: Path, names: list[str], report: Path) -> None:
             "on 24 images at commit 955dc51 (the default before colour parts and stage-4 "
             "rounds): `geometry_955dc51.md`, records in `geometry/955dc51/`.",
         ]
-    wins = defaultdict(int)
+    wins: defaultdict[str, int] = defaultdict(int)
     by_id: dict[str, dict[str, dict[str, Any]]] = defaultdict(dict)
     for record in paired:
         by_id[record["id"]][record["setting"]] = record

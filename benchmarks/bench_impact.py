@@ -62,7 +62,15 @@ def main() -> None:
                 else:
                     kept, canvas = filter_by_impact(candidates, target, threshold)
                 masks = sorted((candidates[i] for i in kept), key=lambda m: -int(m.sum()))
-                traced = trace_masks(masks, target, config.trace.segments, min_pixels)
+                trace = config.trace
+                traced = trace_masks(
+                    masks,
+                    target,
+                    trace.segments or 4,
+                    min_pixels,
+                    None if trace.segments else trace.tolerance,
+                    trace.max_segments,
+                )
                 traced = traced.with_background(uncovered_background(masks, target))
                 mse = float(np.mean((traced.render() - target) ** 2))
                 paths = traced.path_count

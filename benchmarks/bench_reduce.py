@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from collections.abc import Callable
 
 import numpy as np
 from bench_images import REPO, bench_entries, working_image
@@ -34,7 +35,9 @@ def whole_render_costs(scene: Scene, target: np.ndarray) -> np.ndarray:
     return costs / target.size
 
 
-def timed(compute, scene: Scene, target: np.ndarray) -> tuple[np.ndarray, float]:
+def timed(
+    compute: Callable[[Scene, np.ndarray], np.ndarray], scene: Scene, target: np.ndarray
+) -> tuple[np.ndarray, float]:
     started = time.perf_counter()
     costs = compute(scene, target)
     return costs, time.perf_counter() - started

@@ -19,6 +19,7 @@ import os
 import platform
 import statistics
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -42,9 +43,14 @@ def star_path(rng: np.random.Generator, cx: float, cy: float, radius: float) -> 
     return np.stack([cx + radii * np.cos(angles), cy + radii * np.sin(angles)], 1)
 
 
+def _centre(rng: np.random.Generator, size: int) -> tuple[float, float]:
+    cx, cy = rng.uniform(0, size, 2)
+    return float(cx), float(cy)
+
+
 def scene(rng: np.random.Generator, n_paths: int, size: int) -> tuple[np.ndarray, np.ndarray]:
     points = np.stack(
-        [star_path(rng, *rng.uniform(0, size, 2), rng.uniform(5, 60)) for _ in range(n_paths)]
+        [star_path(rng, *_centre(rng, size), rng.uniform(5, 60)) for _ in range(n_paths)]
     )
     colors = rng.uniform(0, 1, (n_paths, 4))
     colors[:, 3] = rng.uniform(0.3, 1.0, n_paths)
@@ -63,7 +69,7 @@ def gradient_paints(rng: np.random.Generator, n_paths: int, size: int) -> Gradie
     return GradientPaints(kinds.astype(np.int64), np.full(n_paths, 3, np.int64), tensor)
 
 
-def median_ms(function, repeats: int) -> float:
+def median_ms(function: Callable[[], None], repeats: int) -> float:
     function()  # warm caches
     times = []
     for _ in range(repeats):
@@ -89,26 +95,42 @@ def run(repeats: int, threads: int) -> list[dict[str, float]]:
             pts = torch.tensor(points, dtype=torch.float32, requires_grad=True)
             cols = torch.tensor(colors, dtype=torch.float32, requires_grad=True)
 
-            def forward(pts=pts, cols=cols, size=size) -> None:
+            def forward(
+                pts: torch.Tensor = pts, cols: torch.Tensor = cols, size: int = size
+            ) -> None:
                 with torch.no_grad():
                     rasterize(pts, cols, size, size)
 
-            def forward_backward(pts=pts, cols=cols, size=size, target=target) -> None:
+            def forward_backward(
+                pts: torch.Tensor = pts,
+                cols: torch.Tensor = cols,
+                size: int = size,
+                target: torch.Tensor = target,
+            ) -> None:
                 pts.grad = cols.grad = None
                 loss = ((rasterize(pts, cols, size, size) - target) ** 2).mean()
                 loss.backward()
 
-            def resvg(svg=svg) -> None:
+            def resvg(svg: str = svg) -> None:
                 resvg_py.svg_to_bytes(svg_string=svg, background="#ffffff")
 
             paints = gradient_paints(rng, n_paths, size)
 
-            def gradient_forward(pts=pts, cols=cols, size=size, paints=paints) -> None:
+            def gradient_forward(
+                pts: torch.Tensor = pts,
+                cols: torch.Tensor = cols,
+                size: int = size,
+                paints: GradientPaints = paints,
+            ) -> None:
                 with torch.no_grad():
                     rasterize(pts, cols, size, size, gradients=paints)
 
             def gradient_forward_backward(
-                pts=pts, cols=cols, size=size, target=target, paints=paints
+                pts: torch.Tensor = pts,
+                cols: torch.Tensor = cols,
+                size: int = size,
+                target: torch.Tensor = target,
+                paints: GradientPaints = paints,
             ) -> None:
                 pts.grad = cols.grad = paints.params.grad = None
                 image = rasterize(pts, cols, size, size, gradients=paints)

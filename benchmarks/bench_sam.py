@@ -55,7 +55,7 @@ def overlay_points(img: np.ndarray, pt: tuple[int, int], masks: np.ndarray) -> n
 def save_small(arr: np.ndarray, path: Path, max_w: int = 900) -> None:
     im = Image.fromarray(arr)
     if im.width > max_w:
-        im = im.resize((max_w, round(im.height * max_w / im.width)), Image.BILINEAR)
+        im = im.resize((max_w, round(im.height * max_w / im.width)), Image.Resampling.BILINEAR)
     im.quantize(colors=128, method=Image.Quantize.MEDIANCUT).save(path, optimize=True)
 
 

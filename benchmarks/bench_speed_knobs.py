@@ -36,6 +36,7 @@ import time
 from collections.abc import Iterator
 from dataclasses import replace
 from typing import Any
+from unittest.mock import patch
 
 import numpy as np
 import torch
@@ -47,7 +48,7 @@ import samvg.optimize.fit as fit_module
 from samvg.config import FitOptions
 from samvg.io import atomic_write_text
 from samvg.metrics import load_lpips, lpips_distance
-from samvg.optimize import FitSettings, fit_scene
+from samvg.optimize import FitResult, FitSettings, fit_scene
 from samvg.optimize.losses import lpips_loss
 from samvg.scene import FlatPaint
 
@@ -84,6 +85,7 @@ def traced_scene(entry: dict[str, str]) -> tuple[samvg.Scene, np.ndarray]:
     cache.parent.mkdir(parents=True, exist_ok=True)
     with cache.open("wb") as handle:
         pickle.dump((result.scene, result.target), handle)
+    assert result.scene is not None and result.target is not None
     return result.scene, result.target
 
 
@@ -95,22 +97,21 @@ def final_scene(entry: dict[str, str]) -> tuple[samvg.Scene, np.ndarray, FitSett
         calls: list[tuple[samvg.Scene, FitSettings]] = []
         original = missing_stage.fit_scene
 
-        def recording(scene: samvg.Scene, target: np.ndarray, settings: FitSettings, *rest: Any):
+        def recording(
+            scene: samvg.Scene, target: np.ndarray, settings: FitSettings, *rest: Any
+        ) -> FitResult:
             if settings.perceptual is not None:
                 calls.append((scene, settings))
             return original(scene, target, settings, *rest)
 
-        missing_stage.fit_scene = recording
-        try:
+        with patch.object(missing_stage, "fit_scene", recording):
             result = samvg.run(BENCH / entry["png"], samvg.Config())
-        finally:
-            missing_stage.fit_scene = original
         scene, settings = calls[-1]
         cache.parent.mkdir(parents=True, exist_ok=True)
-        with cache.open("wb") as handle:
-            pickle.dump((scene, result.target, replace(settings, perceptual=None)), handle)
-    with cache.open("rb") as handle:
-        scene, target, settings = pickle.load(handle)
+        with cache.open("wb") as written:
+            pickle.dump((scene, result.target, replace(settings, perceptual=None)), written)
+    with cache.open("rb") as stored:
+        scene, target, settings = pickle.load(stored)
     perceptual = lpips_loss(target, FitOptions().lpips_size)
     return scene, target, replace(settings, perceptual=perceptual)
 

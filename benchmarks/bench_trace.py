@@ -22,6 +22,7 @@ import statistics
 import sys
 import time
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -82,7 +83,7 @@ def shape_table(repeats: int) -> str:
         for segments in SEGMENTS:
             paths = trace_components(mask, segments)
             coverage = render_coverage([p.points for p in paths], 128, 128)
-            seconds = median_seconds(lambda m=mask, k=segments: trace_components(m, k), repeats)
+            seconds = median_seconds(partial(trace_components, mask, segments), repeats)
             error = max(p.max_error for p in paths)
             cells.append(f"{iou(coverage, mask):.4f} / {error:.1f} / {1000 * seconds:.2f}")
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
@@ -122,7 +123,7 @@ def sam_table(photos: list[tuple[str, np.ndarray, list[np.ndarray]]], repeats: i
         targets = [filled(mask) for mask in masks]
         for segments in summary:
             _, info = trace_masks_with_info(masks, image, segments)
-            seconds = median_seconds(lambda m=masks, i=image, k=segments: trace_masks(m, i, k), 3)
+            seconds = median_seconds(partial(trace_masks, masks, image, segments), 3)
             scores, raw = [], []
             for index, (mask, target) in enumerate(zip(masks, targets, strict=True)):
                 points = [p.points for p in info if p.mask_index == index]
@@ -155,7 +156,7 @@ def speed_line(repeats: int) -> str:
         times.append(time.perf_counter() - start)
     return (
         f"`trace_masks` of 100 random wavy blobs (radius 8-150 px) at 512x512, K=4: "
-        f"{len(result.paths)} paths, median {1000 * statistics.median(times):.0f} ms, "
+        f"{result.path_count} paths, median {1000 * statistics.median(times):.0f} ms, "
         f"min {1000 * min(times):.0f} ms over {repeats} runs."
     )
 

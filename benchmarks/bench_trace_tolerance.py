@@ -268,7 +268,7 @@ def main() -> None:
     shapes = shape_table()
     pictures = load_pictures(args.points)
     rows = []
-    settings = [(f"K={k}", k, None) for k in FIXED]
+    settings: list[tuple[str, int, float | None]] = [(f"K={k}", k, None) for k in FIXED]
     settings += [(f"tol {t:g}", 4, t) for t in TOLERANCES]
     for label, segments, tolerance in settings:
         results = [traced(p, segments, tolerance, args.repeats) for p in pictures]
