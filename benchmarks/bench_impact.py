@@ -77,14 +77,15 @@ def main() -> None:
                 results[str(threshold)].append((paths, canvas.mean_error, mse))
                 print(row["id"], threshold, paths, canvas.mean_error, mse, flush=True)
     count = sum(len(v) for v in chosen.values())
+    grid = config.segment.points_per_side
     lines = [
         "# Filter by impact: threshold against paths and error",
         "",
         f"`python benchmarks/bench_impact.py --per-category {arguments.per_category}`: "
         f"{count} images of ../shared/bench (the first of each category), 512 px, MobileSAM "
-        "AMG 32x32. Means over the images. *e*: the filter's canvas error (mean over pixels of "
-        "the mean squared RGB error, uncovered = 1). *traced MSE*: the traced SVG before any "
-        "optimization. Default threshold: 2e-4.",
+        f"AMG {grid}x{grid}. Means over the images. *e*: the filter's canvas error (mean over "
+        "pixels of the mean squared RGB error, uncovered = 1). *traced MSE*: the traced SVG "
+        "before any optimization. Default threshold: 2e-4.",
         "",
         "| threshold | paths | canvas error e | traced MSE x1e-3 |",
         "|---|---:|---:|---:|",
