@@ -23,8 +23,7 @@ import samvg
 from samvg.imaging import filled_components, resize_longest, to_float_rgb
 from samvg.io import read_image
 from samvg.segment import Segmenter, filter_by_impact, keep_all
-from samvg.trace import trace_masks
-from samvg.trace.stage import uncovered_background
+from samvg.trace.stage import TraceSettings, trace_scene, uncovered_background
 
 REPO = Path(__file__).resolve().parents[1]
 BENCH = Path(os.environ.get("SAMVG_BENCH", REPO.parent / "shared" / "bench"))
@@ -50,7 +49,8 @@ def main() -> None:
             image, _ = resize_longest(read_image(BENCH / row["png"]), config.size)
             target = to_float_rgb(image)
             height, width = target.shape[:2]
-            min_pixels = config.segment.min_pixels(width, height)
+            trace_settings = TraceSettings.from_config(config, width, height)
+            min_pixels = trace_settings.min_pixels
             candidates = [
                 part
                 for mask in segmenter.automatic(image)
@@ -62,15 +62,7 @@ def main() -> None:
                 else:
                     kept, canvas = filter_by_impact(candidates, target, threshold)
                 masks = sorted((candidates[i] for i in kept), key=lambda m: -int(m.sum()))
-                trace = config.trace
-                traced = trace_masks(
-                    masks,
-                    target,
-                    trace.segments or 4,
-                    min_pixels,
-                    None if trace.segments else trace.tolerance,
-                    trace.max_segments,
-                )
+                traced = trace_scene(masks, target, trace_settings)
                 traced = traced.with_background(uncovered_background(masks, target))
                 mse = float(np.mean((traced.render() - target) ** 2))
                 paths = traced.path_count
