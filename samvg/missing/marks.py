@@ -6,11 +6,12 @@ A mark is a connected region of at least ``min_pixels`` pixels (VTracer's speckl
 4 × 4 by default) whose colour differs visibly from the render while the render around it is
 flat. A misplaced edge is not a mark: the render changes colour there. Regions one or two
 pixels wide along the render's edges are the common false alarm, so the wrong pixels are first
-opened with a 2 × 2 square, which keeps strokes two pixels wide. Marks of one colour (within
-``contrast`` ΔE in CIELAB) form one group, offered to the filter as one mask: a texture passes
-or fails as a whole, and each of its components becomes a path of its own colour, traced
-closely and kept as traced: Adam's steps are about a pixel whatever the gradient, which tears a
-two-pixel dash into a streak, so fits move only a mark's paint.
+opened with a 2 × 2 square, which keeps strokes two pixels wide (a path budget's last rounds
+drop the opening, for a star's one-pixel arms: `samvg.missing.stage.smaller_marks`). Marks of
+one colour (within ``contrast`` ΔE in CIELAB) form one group, offered to the filter as one
+mask: a texture passes or fails as a whole, and each of its components becomes a path of its
+own colour, traced closely and kept as traced: Adam's steps are about a pixel whatever the
+gradient, which tears a two-pixel dash into a streak, so fits move only a mark's paint.
 """
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ class MarkSettings:
     """The render's largest colour range around a mark (sum over RGB of max − min)."""
     contrast: float = 10.0
     """ΔE (CIELAB) within which marks share a group's colour."""
+    opening: bool = True
+    """Open the off pixels with a 2 × 2 square first (drops strokes one pixel wide)."""
     max_marks: int = 1024
     """The largest marks kept; the rest wait for a later round."""
     tolerance: float = 0.75
@@ -59,7 +62,9 @@ def mark_groups(
 ) -> list[np.ndarray]:
     """The marks of ``target`` (float RGB) that ``render`` misses, as one boolean mask per colour
     group (``lab``: the target in CIELAB), the group of largest area first."""
-    off = ndimage.binary_opening(error_map(target, render) >= settings.pixel_error, _OPENING)
+    off = error_map(target, render) >= settings.pixel_error
+    if settings.opening:
+        off = ndimage.binary_opening(off, _OPENING)
     labels, count = ndimage.label(off)
     if count == 0:
         return []

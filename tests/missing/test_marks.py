@@ -62,6 +62,14 @@ def test_seams_and_speckle_are_not_marks():
     assert groups(target, flat_render()) == []
 
 
+def test_without_the_opening_strokes_one_pixel_wide_are_marks():
+    target = field({})
+    target[20, 10:60] = LIGHT  # a star's arm, one pixel wide
+    target[50:53, 50:53] = LIGHT  # still speckle
+    found = mark_groups(target, flat_render(), lab_image(target), MarkSettings(opening=False))
+    assert len(found) == 1 and found[0].sum() == 50 and found[0][20, 10:60].all()
+
+
 def test_a_misplaced_edge_is_not_a_mark():
     target = field({})
     target[:, 48:] = DARK

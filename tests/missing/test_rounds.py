@@ -12,6 +12,7 @@ from samvg.missing.stage import (
     budget_pool,
     eased_settings,
     offer_wrong_regions,
+    smaller_marks,
 )
 from samvg.optimize import FitSettings
 from samvg.scene import Scene
@@ -191,3 +192,37 @@ def test_a_budget_pool_leaves_room_to_grow_a_scene_that_already_fills_it():
     full = add_missing_rounds(blank_scene(), target(), SilentSegmenter(), STAGES, pool=2).scene
     done = add_missing_rounds(full, target(), SilentSegmenter(), STAGES, pool=budget_pool(1, 2))
     assert done.added == 1 and done.scene.path_count == 3
+
+
+def starry_target() -> np.ndarray:
+    """A dark 64 x 64 sky with twelve stars, each a cross of five pixels with one-pixel arms."""
+    image = np.empty((64, 64, 3), np.float32)
+    image[:] = (0.1, 0.15, 0.3)
+    for row in range(8, 60, 16):
+        for col in range(10, 60, 20):
+            image[row - 1 : row + 2, col] = 0.95
+            image[row, col - 1 : col + 2] = 0.95
+    return image
+
+
+def test_a_budget_pool_looks_for_smaller_marks_once_the_error_bars_are_spent():
+    sky = Scene(64, 64, background=(0.1, 0.15, 0.3))
+    starry = (replace(settings(), marks=MarkSettings()), *STAGES[1:])
+    unbudgeted = add_missing_rounds(sky, starry_target(), SilentSegmenter(), starry)
+    assert unbudgeted.added == 0  # five pixels: speckle at VTracer's 16
+    done = add_missing_rounds(sky, starry_target(), SilentSegmenter(), starry, pool=20)
+    assert done.added == 12 and "and marks of 4 px" in done.stopped
+    error = np.mean((done.scene.render() - starry_target()) ** 2)
+    assert error < np.mean((sky.render() - starry_target()) ** 2) / 4
+
+
+def test_smaller_marks_halve_their_size_at_the_first_error_bar():
+    first = MarkSettings(pixel_error=0.15)
+    eased = eased_settings(eased_settings(replace(settings(), marks=first)))
+    smaller = smaller_marks(eased, first)
+    assert smaller.marks is not None and smaller.threshold == eased.threshold
+    assert (smaller.marks.min_pixels, smaller.marks.pixel_error) == (8, 0.15)
+    assert smaller.marks.opening and smaller.marks_only
+    finest = smaller_marks(smaller, first, finest=True).marks
+    assert finest is not None and (finest.min_pixels, finest.opening) == (4, False)
+    assert smaller_marks(settings(), first) == settings()  # no marks: nothing to ease
