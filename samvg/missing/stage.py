@@ -371,9 +371,9 @@ def smaller_marks(
     """``settings`` with marks of half the smallest size, at the marks' ``first`` error bar: at
     the eased bars a wallpaper's stars join the error of its smooth background into regions
     that are not flat, so none is a mark. ``finest``: strokes one pixel wide count too (no
-    opening; a star's arms). debian_spacefun at 256 paths: 20 -> 37 paths, LPIPS 0.256 -> 0.102
+    opening; a star's arms). debian_spacefun at 256 paths: 20 -> 37 paths, LPIPS 0.256 -> 0.093
     (VTracer at <= 256 paths: 0.190). Only the marks are offered: SAM's prompts and the
-    wrong-colour regions found nothing at these bars already (kodim02: 3 s a round saved)."""
+    wrong-colour regions found nothing at these bars already (kodim02: 2 s a round saved)."""
     if settings.marks is None:
         return settings
     marks = replace(
