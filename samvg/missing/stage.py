@@ -40,8 +40,8 @@ BUDGET_GROWTH = 0.25
 BUDGET_EASINGS = 3
 #: After the error bars, a budget's rounds that still find nothing look for smaller marks this
 #: many times (see `smaller_marks`): 16 px (VTracer's speckle) down to 4 px, the stars of a
-#: wallpaper. Only once the bars are spent: marks this small offered earlier fill the pool and go
-#: as idle paths in the finish pass (kodim02 at 256 paths ended with 163, not 241).
+#: wallpaper. Only once the bars are spent: halved together with the bars, the marks' size cost
+#: kodim02 at 256 paths 78 of its 241 paths (MSE 1.41 -> 1.54e-3, LPIPS 0.324 -> 0.349).
 MARK_EASINGS = 2
 
 
