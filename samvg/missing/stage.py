@@ -132,10 +132,11 @@ def missing_masks(
             use_filter=settings.filter_by_impact,
             below=False,
         )
-    if settings.colour_split is not None and not settings.marks_only:
-        lab = lab_image(target)
-        offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact, False, lab)
-        offer_wrong_regions(canvas, render, settings.pixel_error, settings.colour_split, lab)
+        if settings.colour_split is not None:
+            lab = lab_image(target)
+            split = settings.colour_split
+            offer_colour_parts(canvas, split, settings.filter_by_impact, False, lab)
+            offer_wrong_regions(canvas, render, settings.pixel_error, split, lab)
     regions = len(canvas.kept_masks)
     if settings.marks is not None:
         lab = lab_image(target) if lab is None else lab
