@@ -289,9 +289,11 @@ def _vectorize_one(
             for stage, seconds in result.timings.items()
             if stage != "total"
         )
+        scene = result.image.scene
+        shapes = f" ({scene.path_count} shapes)" if scene.path_count != scene.element_count else ""
         _say(
             console,
-            f"wrote {output}: {len(result.image.paths)} paths, MSE {result.mse:.5f}, "
+            f"wrote {output}: {scene.element_count} paths{shapes}, MSE {result.mse:.5f}, "
             f"{time.perf_counter() - started:.1f}s ({timings})",
         )
         if preview is not None:
@@ -402,7 +404,8 @@ def _add_tuning_options(vectorize: argparse.ArgumentParser) -> None:
     vectorize.add_argument(
         "--paths",
         type=int,
-        help="exactly this many paths, when the image holds that much detail (default: as "
+        help="exactly this many paths (SVG <path> elements: the pieces of one shape may be one "
+        "compound path, as in Illustrator), when the image holds that much detail (default: as "
         "--detail decides)",
     )
     vectorize.add_argument(

@@ -27,6 +27,7 @@ from samvg.finish import (
     flatten_paths,
     simplify_paths,
 )
+from samvg.finish.compound import join_pieces
 from samvg.finish.outline import polygon_areas
 from samvg.finish.whole_pixels import ROUNDING_SHARE, whole_pixel_paths
 from samvg.imaging import alpha_channel, resize_longest, to_float_rgb, to_rgb_uint8
@@ -274,7 +275,7 @@ def _run_stages(
     if budget is not None:
         scene = _reduce(scene, inputs, fit, budget, result, report, fitted)
     if config.finish.finish_pass:
-        scene = _finish_pass(scene, config, inputs, result, report)
+        scene = _finish_pass(scene, config, inputs, result, report, join_to=budget)
     if budget is not None:
         scene = _meet_budget(scene, inputs, budget, result)
     simple = config.finish.finish_pass
@@ -289,15 +290,21 @@ def _finish_pass(
     result: PipelineResult,
     report: ProgressCallback,
     background: bool = True,
+    join_to: int | None = None,
 ) -> Scene:
     """The finish pass (``background``: whether a path over the whole canvas may become the
-    background)."""
+    background). With ``join_to``, the pieces a repair split off are joined into compound paths
+    (`join_pieces`) until the scene has that many SVG elements, before idle paths and gradients
+    are looked at: a gradient made flat in one piece and not in the other would keep them
+    apart."""
     with _timed(result, "finish"):
         report("finish", 0, 1)
         settings = replace(_finish_settings(config, inputs), background_from_path=background)
         finished = finish_scene(scene, settings)
         scene = _within(finished.scene.with_fixed_from(scene), config, by_area=True)
         counts = dict(finished.counts)
+        if join_to is not None:
+            scene, counts["compound_joined"] = join_pieces(scene, join_to)
         if config.finish.remove_idle:
             scene, counts["idle_removed"] = remove_idle_paths(scene, inputs.target, IDLE_COST)
         if config.finish.flatten_idle_gradients:
@@ -312,14 +319,17 @@ def _finish_pass(
 
 
 def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineResult) -> Scene:
-    """Paths the finish pass split off beyond the budget are removed (least cost first); a
-    scene short of the budget says why."""
-    if scene.path_count > budget:
+    """Paths the finish pass split off beyond the budget are joined into compound paths where
+    they share their paint and no area with the path below (`join_pieces`), and removed (least
+    cost first) where that is not enough; a scene short of the budget says why."""
+    scene, joined = join_pieces(scene, budget)
+    result.counts["compound_joined"] = result.counts.get("compound_joined", 0) + joined
+    if scene.element_count > budget:
         scene, removed = reduce_paths(scene, inputs.target, budget)
         result.counts["reduced"] = result.counts.get("reduced", 0) + removed
-    if scene.path_count < budget:
+    if scene.element_count < budget:
         result.notes.append(
-            f"{scene.path_count} paths, not {budget}: no further path lowers the error "
+            f"{scene.element_count} paths, not {budget}: no further path lowers the error "
             "measurably (or the finish pass merged touching paths of one colour, or made a path "
             "over the whole canvas the background)"
         )
@@ -454,18 +464,22 @@ def _within(scene: Scene, config: Config, by_area: bool = False) -> Scene:
     traced into several paths, or a path the finish pass split, must not break the promise):
     the first ones, or with ``by_area`` the largest ones, in paint order."""
     limit = config.segment.max_paths
-    if limit is None or scene.path_count <= limit:
+    if limit is None or scene.element_count <= limit:
         return scene
     return _largest(scene, limit) if by_area else scene.subset(range(limit))
 
 
 def _largest(scene: Scene, limit: int | None) -> Scene:
-    """``scene`` with at most ``limit`` paths (None: all): its largest ones, in paint order."""
-    if limit is None or scene.path_count <= limit:
+    """``scene`` with at most ``limit`` SVG elements (None: all): its largest ones (a compound
+    path by the area of all its pieces), in paint order."""
+    if limit is None or scene.element_count <= limit:
         return scene
     vertices, vertex_offsets = flatten_paths(scene.points, scene.offsets)
     areas = polygon_areas(vertices, vertex_offsets)
-    return scene.subset(np.sort(np.argsort(-areas, kind="stable")[:limit]))
+    elements = scene.elements()
+    sizes = [float(areas[list(element)].sum()) for element in elements]
+    largest = np.sort(np.argsort(-np.asarray(sizes), kind="stable")[:limit])
+    return scene.subset([path for chosen in largest for path in elements[int(chosen)]])
 
 
 def _path_limit(config: Config) -> int | None:
@@ -527,7 +541,8 @@ def _finish(
                 written = saved.on_canvas(*working)
                 result.mse = float(np.mean((written.render() - target) ** 2))
     result.image = VectorImage.from_scene(saved)
-    result.counts["paths"] = result.image.scene.path_count
+    result.counts["paths"] = result.image.scene.element_count
+    result.counts["shapes"] = result.image.scene.path_count
     result.counts["gradient_fills"] = sum(
         not isinstance(paint, FlatPaint) for paint in result.image.scene.paints
     )

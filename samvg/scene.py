@@ -16,6 +16,11 @@ Paints are immutable values, one per path: a flat RGBA fill, or a linear or radi
 
 The background is an opaque RGB colour, or an opaque linear or radial gradient
 (``background_gradient``); with a gradient, ``background`` holds its flat stand-in.
+
+An SVG ``<path>`` element may hold several paths: a path ``joined`` to the one below it, with the
+same paint, is one more subpath of that element (a compound path, as Illustrator and VTracer
+write one shape of one fill in several pieces). The element paints what its paths paint one by
+one: opaque pieces may overlap, translucent ones may not (`samvg.finish.compound`).
 """
 
 from __future__ import annotations
@@ -249,6 +254,11 @@ class Scene:
     """(P,) bool: paths whose outline a fit leaves as traced (only their paint is fitted), or
     None for none. Kept by `with_geometry`, `stacked` and `subset`; new paths start free."""
 
+    joined: np.ndarray | None = None
+    """(P,) bool: paths that are one more subpath of the SVG element of the path below them
+    (see the module docstring), or None for none. Kept by `with_geometry`, `stacked` and
+    `subset` (while the path below stays); new paths start on their own."""
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "width", _check_canvas(self.width, "width"))
         object.__setattr__(self, "height", _check_canvas(self.height, "height"))
@@ -279,6 +289,11 @@ class Scene:
             if fixed.shape != (len(counts),):
                 raise InputError(f"{len(counts)} paths but {len(fixed)} fixed flags")
             object.__setattr__(self, "fixed", fixed if fixed.any() else None)
+        if self.joined is not None:
+            joined = np.asarray(self.joined, dtype=bool)
+            if joined.shape != (len(counts),):
+                raise InputError(f"{len(counts)} paths but {len(joined)} joined flags")
+            object.__setattr__(self, "joined", joined if joined[1:].any() else None)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -333,6 +348,25 @@ class Scene:
     def path_count(self) -> int:
         return len(self.offsets) - 1
 
+    def elements(self) -> list[range]:
+        """The SVG ``<path>`` elements as runs of paths, bottom first: a path `joined` to the one
+        below it with the very same paint extends that path's run."""
+        joined = self.joined_paths()
+        starts = [0] if self.path_count else []
+        for index in range(1, self.path_count):
+            if not (joined[index] and self.paints[index] == self.paints[index - 1]):
+                starts.append(index)
+        return [range(a, b) for a, b in zip(starts, [*starts[1:], self.path_count], strict=True)]
+
+    @property
+    def element_count(self) -> int:
+        """How many ``<path>`` elements the SVG of this scene holds (see `elements`)."""
+        return len(self.elements()) if self.joined is not None else self.path_count
+
+    def joined_paths(self) -> np.ndarray:
+        """(P,) bool: which paths are joined to the one below (`joined`, all False when None)."""
+        return np.zeros(self.path_count, bool) if self.joined is None else self.joined
+
     def segment_counts(self) -> np.ndarray:
         """K of every path, (P,) int64."""
         return np.diff(self.offsets) // 3
@@ -383,7 +417,7 @@ class Scene:
         (canvas, background and frame kept)."""
         points, offsets = _pack(paths)
         paints = tuple(paint for _, paint in paths)
-        return replace(self, points=points, offsets=offsets, paints=paints, fixed=None)
+        return replace(self, points=points, offsets=offsets, paints=paints, fixed=None, joined=None)
 
     def with_background(self, background: Sequence[float] | None) -> Scene:
         """The scene over a flat ``background`` (None: white); a background gradient goes."""
@@ -399,12 +433,18 @@ class Scene:
             offsets=np.concatenate([self.offsets, above.offsets[1:] + len(self.points)]),
             paints=self.paints + above.paints,
             fixed=np.concatenate([self.fixed_paths(), above.fixed_paths()]),
+            joined=np.concatenate([self.joined_paths(), above.joined_paths()]),
         )
 
     def subset(self, keep: Sequence[int] | np.ndarray) -> Scene:
         """Only the paths at indices ``keep`` (in the order given)."""
-        kept = self.with_paths([(self.path_points(int(i)), self.paints[int(i)]) for i in keep])
-        return replace(kept, fixed=self.fixed_paths()[np.asarray(keep, dtype=np.int64)])
+        indices = np.asarray(keep, dtype=np.int64).reshape(-1)
+        kept = self.with_paths([(self.path_points(int(i)), self.paints[int(i)]) for i in indices])
+        joined = None
+        if self.joined is not None and len(indices):
+            element = np.cumsum(~self.joined) - 1
+            joined = np.concatenate([[False], element[indices[1:]] == element[indices[:-1]]])
+        return replace(kept, fixed=self.fixed_paths()[indices], joined=joined)
 
     def fixed_paths(self) -> np.ndarray:
         """(P,) bool: which paths keep their outline in a fit (`fixed`, all False when None)."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -85,18 +85,20 @@ class VectorImage:
 
     @property
     def paths(self) -> list[VectorPath]:
-        """Copies of the paths, in paint order."""
+        """Copies of the closed paths, in paint order (each piece of a compound path is one:
+        see `Scene.elements` for the SVG's ``<path>`` elements)."""
         return [VectorPath(points.copy(), paint.rgba) for points, paint in self._scene.paths()]
 
     def __repr__(self) -> str:
         return (
-            f"VectorImage({self.width}x{self.height}, {self._scene.path_count} paths, "
+            f"VectorImage({self.width}x{self.height}, {self._scene.element_count} paths, "
             f"background={self.background})"
         )
 
     # ------------------------------------------------------------------ output
     def to_svg(self, precision: int = DEFAULT_PRECISION) -> str:
-        """SVG text: width, height, viewBox, an optional background rect and one path each."""
+        """SVG text: width, height, viewBox, an optional background rect and one ``<path>`` per
+        element (a compound path's pieces are its subpaths)."""
         return scene_to_svg(self._scene, precision)
 
     def save(self, path: str | os.PathLike[str], precision: int = DEFAULT_PRECISION) -> None:
@@ -130,12 +132,12 @@ class VectorImage:
             (points, FlatPaint(fill) if isinstance(fill, tuple) else fill)
             for points, fill in parsed.paths
         ]
-        return cls.from_scene(
-            Scene.from_paths(
-                parsed.width,
-                parsed.height,
-                paths,
-                parsed.background,
-                background_gradient=parsed.background_gradient,
-            )
+        scene = Scene.from_paths(
+            parsed.width,
+            parsed.height,
+            paths,
+            parsed.background,
+            background_gradient=parsed.background_gradient,
         )
+        joined = np.array(parsed.joined, dtype=bool) if parsed.joined else None
+        return cls.from_scene(replace(scene, joined=joined))

@@ -1,9 +1,11 @@
 """Applying per-path edits to a scene: a path is kept, replaced by one or more paths in its place
-in paint order (a split), or dropped; everything else about the scene is kept."""
+in paint order (a split), or dropped; everything else about the scene is kept (a path joined into
+a compound path passes that on to the first path that replaces it)."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -14,16 +16,23 @@ Edit = Sequence[tuple[np.ndarray, Paint]]
 
 
 def apply_edits(scene: Scene, edits: Mapping[int, Edit]) -> Scene:
-    """``scene`` with path ``i`` replaced by ``edits[i]`` for every ``i`` in ``edits``."""
+    """``scene`` with path ``i`` replaced by ``edits[i]`` for every ``i`` in ``edits``. A path
+    of a compound path passes its place in it on to its first replacement; parts split off stand
+    on their own (`samvg.finish.compound` may join them), and so does the path after them."""
     if not edits:
         return scene
     paths: list[tuple[np.ndarray, Paint]] = []
+    joined: list[bool] = []
+    element = np.cumsum(~scene.joined_paths())
+    last_element = -1
     for index, (points, paint) in enumerate(scene.paths()):
-        if index in edits:
-            paths.extend(edits[index])
-        else:
-            paths.append((points, paint))
-    return scene.with_paths(paths)
+        replaced = edits.get(index, [(points, paint)])
+        for part, path in enumerate(replaced):
+            paths.append(path)
+            joined.append(part == 0 and element[index] == last_element)
+            last_element = element[index] if part == 0 else -1
+    edited = scene.with_paths(paths)
+    return replace(edited, joined=np.array(joined)) if scene.joined is not None else edited
 
 
 def edit_counts(step: str, scene: Scene, edits: Mapping[int, Edit], holes: int) -> dict[str, int]:

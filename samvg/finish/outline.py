@@ -46,13 +46,19 @@ def simple_mask(vertices: np.ndarray, vertex_offsets: np.ndarray) -> np.ndarray:
 
 def polygon_areas(vertices: np.ndarray, vertex_offsets: np.ndarray) -> np.ndarray:
     """(P,) unsigned shoelace areas of the polygons (the painted area of a simple one)."""
+    return np.abs(signed_polygon_areas(vertices, vertex_offsets))
+
+
+def signed_polygon_areas(vertices: np.ndarray, vertex_offsets: np.ndarray) -> np.ndarray:
+    """(P,) signed shoelace areas of the polygons: positive for those that run clockwise on
+    the screen (y pointing down)."""
     if len(vertex_offsets) <= 1:
         return np.zeros(0)
     following = np.arange(len(vertices)) + 1
     following[vertex_offsets[1:] - 1] = vertex_offsets[:-1]
     x, y = vertices[:, 0], vertices[:, 1]
     cross = x * y[following] - x[following] * y
-    return np.abs(np.add.reduceat(cross, vertex_offsets[:-1])) / 2.0
+    return np.add.reduceat(cross, vertex_offsets[:-1]) / 2.0
 
 
 def winding_numbers(queries: np.ndarray, ring: np.ndarray) -> np.ndarray:

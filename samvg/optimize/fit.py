@@ -312,6 +312,7 @@ class _Parameters:
             scene = self.scene.with_geometry(points, colours)
         else:
             scene = replace(self.scene, points=points, paints=self.gradients.paints(colours))
+        scene = replace(scene, joined=None)  # fitted pieces may overlap: each its own element
         if self.background is None:
             return scene
         gradient = cast(BackgroundGradient, self.background.paints(np.ones((1, 4)))[0])

@@ -49,11 +49,12 @@ def removal_costs(scene: Scene, target: np.ndarray) -> np.ndarray:
 
 
 def reduce_paths(scene: Scene, target: np.ndarray, count: int) -> tuple[Scene, int]:
-    """``scene`` with at most ``count`` paths, removing half the excess (at least one path) of
-    least removal cost per batch; returns the scene and how many paths were removed."""
+    """``scene`` with at most ``count`` SVG elements (`Scene.element_count`: paths, or compound
+    paths), removing half the excess (at least one path) of least removal cost per batch;
+    returns the scene and how many paths were removed."""
     removed = 0
-    while scene.path_count > count:
-        excess = scene.path_count - count
+    while scene.element_count > count:
+        excess = scene.element_count - count
         batch = max(1, excess // 2) if excess > 4 else excess
         dropped = set(cheapest_together(scene, target, removal_costs(scene, target), batch))
         scene = scene.subset([index for index in range(scene.path_count) if index not in dropped])
@@ -270,7 +271,12 @@ def flatten_idle_gradients(
     colour, smallest change first, each measured again against the fills flattened before it,
     the changes together within ``share`` of the scene's MSE against ``target``; returns it and
     how many fills went flat. A gradient costs some 200 bytes of SVG; a flat fill, seven."""
-    gradients = [i for i, paint in enumerate(scene.paints) if not isinstance(paint, FlatPaint)]
+    pieces = {path for element in scene.elements() if len(element) > 1 for path in element}
+    gradients = [
+        index
+        for index, paint in enumerate(scene.paints)
+        if not isinstance(paint, FlatPaint) and index not in pieces  # a compound's paint is one
+    ]
     if not gradients and scene.background_gradient is None:
         return scene, 0
     budget = share * float(np.mean((scene.render() - target) ** 2))

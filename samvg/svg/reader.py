@@ -10,6 +10,10 @@ path, length and transform syntax, element labels for errors (``svg/g[1]/path[3]
 refusal of what the scene cannot hold, and the viewBox-to-pixel map, computed here so that SVG
 written by samvg reads back to exactly the numbers in its text.
 
+A ``<path>`` of several subpaths reads as a compound path (`Scene.joined`) when its subpaths
+paint no area in common, or when its fill is opaque and they all run the same way round (it
+paints their union then); others (holes) are refused.
+
 A path with K segments holds 3K control points; segment k runs from ``points[3k]`` through
 ``points[3k+1]`` and ``points[3k+2]`` to ``points[(3k+3) % 3K]``.
 """
@@ -28,6 +32,9 @@ import numpy as np
 import svgelements
 
 from samvg.errors import InputError
+from samvg.finish.compound import MAX_SHARED_AREA, one_way_round
+from samvg.finish.flatten import flatten_paths
+from samvg.finish.outline import path_regions
 from samvg.scene import LinearGradient, RadialGradient
 from samvg.svg.gradients import gradient_paint
 from samvg.svg.values import number
@@ -128,6 +135,9 @@ class ParsedSvg:
     background: tuple[float, float, float] | None
     paths: list[tuple[np.ndarray, _Fill]]
     background_gradient: _Gradient | None = None
+    joined: list[bool] = field(default_factory=list)
+    """Per path, whether it is one more subpath of the ``<path>`` of the path before it (a
+    compound path, whose subpaths paint no area in common); empty for none."""
 
 
 def read_svg(text: str) -> ParsedSvg:
@@ -159,9 +169,16 @@ def read_svg(text: str) -> ParsedSvg:
     if isinstance(background, (LinearGradient, RadialGradient)):
         red, green, blue, _ = background.rgba
         return ParsedSvg(
-            geometry.pixel_width, geometry.pixel_height, (red, green, blue), scene.paths, background
+            geometry.pixel_width,
+            geometry.pixel_height,
+            (red, green, blue),
+            scene.paths,
+            background,
+            scene.joined,
         )
-    return ParsedSvg(geometry.pixel_width, geometry.pixel_height, background, scene.paths)
+    return ParsedSvg(
+        geometry.pixel_width, geometry.pixel_height, background, scene.paths, joined=scene.joined
+    )
 
 
 # ---------------------------------------------------------------------- XML and canvas
@@ -444,6 +461,7 @@ class _Scene:
     ids: dict[str, ElementTree.Element] = field(default_factory=dict)
     background: tuple[float, float, float] | _Gradient | None = None
     paths: list[tuple[np.ndarray, _Fill]] = field(default_factory=list)
+    joined: list[bool] = field(default_factory=list)
 
 
 def _label(element: Any, use_label: str | None) -> str:
@@ -505,20 +523,34 @@ def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
     fill = _fill(values, opacity, label, scene, shape.transform)
     # Cubics in the shape's own coordinates, then its transform: svgelements' transformed arcs
     # are wrong under skews (it keeps ellipse axes orthogonal), while cubics map exactly.
-    local = _cubic_points(shape.segments(transformed=False), label)
-    points = scene.geometry.to_pixels(_affine(shape.transform, local))
-    if not np.all(np.isfinite(points)):
-        raise InputError(f"{label}: non-finite coordinates")
+    pieces = []
+    for segments in _subpaths(shape.segments(transformed=False)):
+        local = _cubic_points(segments, label)
+        points = scene.geometry.to_pixels(_affine(shape.transform, local))
+        if not np.all(np.isfinite(points)):
+            raise InputError(f"{label}: non-finite coordinates")
+        pieces.append(points)
+    if not pieces:
+        raise InputError(f"{label}: path has no segments")
+    opaque = fill[3] >= 1.0 if isinstance(fill, tuple) else fill.opaque
+    if len(pieces) > 1 and not ((opaque and one_way_round(pieces)) or _apart(pieces)):
+        raise InputError(
+            f"{label}: subpaths of one <path> that overlap (holes) are not supported; "
+            "split them into separate paths"
+        )
     if (
-        isinstance(shape, svgelements.Rect)
+        len(pieces) == 1
+        and isinstance(shape, svgelements.Rect)
         and not scene.paths
         and scene.background is None
-        and (fill[3] >= 1.0 if isinstance(fill, tuple) else fill.opaque)
-        and _covers_canvas(points, scene.geometry)
+        and opaque
+        and _covers_canvas(pieces[0], scene.geometry)
     ):
         scene.background = (fill[0], fill[1], fill[2]) if isinstance(fill, tuple) else fill
         return
-    scene.paths.append((points, fill))
+    for index, points in enumerate(pieces):
+        scene.paths.append((points, fill))
+        scene.joined.append(index > 0)
 
 
 def _covers_canvas(points: np.ndarray, geometry: _Geometry) -> bool:
@@ -612,11 +644,33 @@ def _colour(text: str, label: str) -> _Rgba:
 
 
 # ---------------------------------------------------------------------- segments to cubics
+def _subpaths(segments: Iterable[Any]) -> list[list[Any]]:
+    """svgelements segments cut before every move: one list per subpath."""
+    found: list[list[Any]] = []
+    for segment in segments:
+        if isinstance(segment, svgelements.Move) or not found:
+            found.append([])
+        found[-1].append(segment)
+    return found
+
+
+def _apart(pieces: list[np.ndarray]) -> bool:
+    """Whether closed cubic paths paint no area in common (a compound path's pieces; one
+    inside another would be a hole, which the scene cannot hold)."""
+    points = np.concatenate(pieces)
+    offsets = np.cumsum([0] + [len(piece) for piece in pieces])
+    vertices, vertex_offsets = flatten_paths(points, offsets)
+    regions = path_regions(vertices, vertex_offsets)
+    return all(
+        regions[a].intersection(regions[b]).area <= MAX_SHARED_AREA
+        for a in range(len(regions))
+        for b in range(a)
+    )
+
+
 def _cubic_points(segments: Iterable[Any], label: str) -> np.ndarray:
     """One closed subpath of svgelements segments as (3K, 2) cubic control points."""
-    several = (
-        f"{label}: several subpaths in one <path> are not supported; split them into separate paths"
-    )
+    several = f"{label}: a subpath after z must start with M"
     rows: list[tuple[float, float]] = []
     start: tuple[float, float] | None = None
     current = (0.0, 0.0)

@@ -1,11 +1,12 @@
 """SVG text of a `Scene`: width, height and viewBox, an optional background rectangle, and one
-``<path>`` per path: an absolute move, then relative cubic commands (``c``, repeated
-implicitly), coordinates rounded to a fixed precision first so the relative steps add up to
-exactly the rounded points, numbers written as short as SVG allows (no leading zero, no
-separator before a minus sign). A gradient fill is a ``<linearGradient>`` or
-``<radialGradient>`` (userSpaceOnUse) in ``<defs>``, ids ``g0``, ``g1``, … with paths of
-identical gradients sharing one, referenced by ``fill="url(#…)"``; a background gradient is the
-background rectangle's fill, id ``bg``.
+``<path>`` per SVG element of the scene (`Scene.elements`: one path, or the pieces of a
+compound path, each a subpath, all drawn the same way round): an absolute move, then relative
+cubic commands (``c``, repeated implicitly), coordinates rounded to a fixed precision first
+so the relative steps add up to exactly the rounded points, numbers written as short as SVG
+allows (no leading zero, no separator before a minus sign). A gradient fill is a
+``<linearGradient>`` or ``<radialGradient>`` (userSpaceOnUse) in ``<defs>``, ids ``g0``,
+``g1``, … with paths of identical gradients sharing one, referenced by ``fill="url(#…)"``; a
+background gradient is the background rectangle's fill, id ``bg``.
 
 Written by hand: the output is a dozen lines of fixed shape, and its bytes must not depend on
 a library's formatting choices (tests compare them).
@@ -18,6 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from samvg.errors import InputError
+from samvg.finish.compound import same_way_round
 from samvg.scene import FlatPaint, LinearGradient, Paint, Scene
 
 SVG_NAMESPACE = "http://www.w3.org/2000/svg"
@@ -112,13 +114,19 @@ def scene_to_svg(scene: Scene, precision: int = DEFAULT_PRECISION) -> str:
     definitions += gradient_definitions
     if definitions:
         lines += ["<defs>", *definitions, "</defs>"]
-    for index, (points, paint) in enumerate(scene.paths()):
+    for element in scene.elements():
+        index = element[0]
+        paint = scene.paints[index]
         opacity = paint.rgba[3]
         opacity_attribute = "" if opacity >= 1.0 else f' fill-opacity="{number(opacity, 3)}"'
         fill = (
             f"url(#{gradient_ids[index]})" if index in gradient_ids else hex_colour(paint.rgba[:3])
         )
-        lines.append(f'<path d="{path_data(points, precision)}" fill="{fill}"{opacity_attribute}/>')
+        pieces = [scene.path_points(path) for path in element]
+        if len(pieces) > 1:
+            pieces = same_way_round(pieces)
+        data = "".join(path_data(piece, precision) for piece in pieces)
+        lines.append(f'<path d="{data}" fill="{fill}"{opacity_attribute}/>')
     lines.append("</svg>")
     return "\n".join(lines) + "\n"
 

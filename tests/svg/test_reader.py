@@ -88,6 +88,16 @@ def test_samvg_written_svg_reads_back_exactly():
     assert fill == (0x12 / 255, 0x34 / 255, 0x56 / 255, 0.93)
 
 
+def test_subpaths_apart_or_one_way_round_read_as_one_compound_path():
+    apart = read_svg(svg('<path d="M0 0 L5 5 L0 5 Z M6 6 L8 8 L6 8 Z" fill-opacity=".5"/>'))
+    assert len(apart.paths) == 2 and apart.joined == [False, True]
+    # opaque, overlapping, both clockwise on the screen: the union, which painting both gives
+    overlapping = read_svg(svg('<path d="M0 0 L10 0 L10 10 Z M2 1 L9 1 L9 8 Z"/>'))
+    assert overlapping.joined == [False, True]
+    single = read_svg(svg('<path d="M0 0 L5 5 L0 5 Z"/><path d="M6 6 L8 8 L6 8 Z"/>'))
+    assert single.joined == [False, False]
+
+
 def _number(value: float) -> str:
     text = f"{value:.6f}".rstrip("0").rstrip(".")
     return "0" if text in ("-0", "") else text
@@ -473,8 +483,9 @@ def test_svg_without_namespace_doctype_and_xml_declaration_are_read():
 @pytest.mark.parametrize(
     ("body", "message"),
     [
-        ('<path d="M0 0 L5 5 L0 5 Z M6 6 L8 8 L6 8 Z"/>', "several subpaths"),
-        ('<path d="M0 0 L5 5 L0 5 Z L3 3"/>', "several subpaths"),
+        ('<path d="M0 0 L10 0 L10 10 L0 10 Z M2 2 L2 8 L8 8 L8 2 Z"/>', "overlap (holes)"),
+        ('<path d="M0 0 L10 0 L10 10 Z M2 1 L9 1 L9 8 Z" fill-opacity=".5"/>', "overlap (holes)"),
+        ('<path d="M0 0 L5 5 L0 5 Z L3 3"/>', "a subpath after z must start with M"),
         (f'<path id="p1" {TRIANGLE} stroke="#000"/>', "svg/path[1] (id='p1'): strokes"),
         (f'<g style="stroke:red"><path {TRIANGLE}/></g>', "strokes are not supported"),
         (f'<path {TRIANGLE} fill="url(#g)"/>', "fill='url(#g)' names no gradient"),
