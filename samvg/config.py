@@ -85,6 +85,9 @@ class SegmentOptions:
     (the paper does not)."""
     split_contrast: float = 10.0
     """Smallest colour difference (CIELAB ΔE) that splits a mask."""
+    tonal_regions: bool = True
+    """Under a path budget, offer the blurred image's tonal regions (`samvg.segment.tonal`) to
+    the filter by impact as well, beneath SAM's masks."""
 
     def __post_init__(self) -> None:
         if self.model not in SAM_MODELS:

@@ -294,19 +294,19 @@ def _finish_pass(
 ) -> Scene:
     """The finish pass (``background``: whether a path over the whole canvas may become the
     background). With ``join_to``, the pieces a repair split off are joined into compound paths
-    (`join_pieces`) until the scene has that many SVG elements, before idle paths and gradients
-    are looked at: a gradient made flat in one piece and not in the other would keep them
-    apart."""
+    (`join_pieces`) until the scene has that many SVG elements: after the idle paths go (or
+    joins made for them would leave the scene short of a budget), before idle gradients go
+    flat (a gradient made flat in one piece and not in the other would keep them apart)."""
     with _timed(result, "finish"):
         report("finish", 0, 1)
         settings = replace(_finish_settings(config, inputs), background_from_path=background)
         finished = finish_scene(scene, settings)
         scene = _within(finished.scene.with_fixed_from(scene), config, by_area=True)
         counts = dict(finished.counts)
-        if join_to is not None:
-            scene, counts["compound_joined"] = join_pieces(scene, join_to)
         if config.finish.remove_idle:
             scene, counts["idle_removed"] = remove_idle_paths(scene, inputs.target, IDLE_COST)
+        if join_to is not None:
+            scene, counts["compound_joined"] = join_pieces(scene, join_to)
         if config.finish.flatten_idle_gradients:
             scene, counts["gradients_flattened"] = flatten_idle_gradients(
                 scene, inputs.target, IDLE_COST
@@ -354,6 +354,7 @@ def _segment(
         kept_masks=selection.kept_after_filter,
         reprompt_masks=selection.reprompt_masks,
         colour_parts=selection.colour_parts,
+        tonal_regions=selection.tonal_regions,
     )
     return segmenter, result.masks
 

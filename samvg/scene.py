@@ -351,8 +351,10 @@ class Scene:
     def elements(self) -> list[range]:
         """The SVG ``<path>`` elements as runs of paths, bottom first: a path `joined` to the one
         below it with the very same paint extends that path's run."""
+        if self.path_count == 0:
+            return []
         joined = self.joined_paths()
-        starts = [0] if self.path_count else []
+        starts = [0]
         for index in range(1, self.path_count):
             if not (joined[index] and self.paints[index] == self.paints[index - 1]):
                 starts.append(index)

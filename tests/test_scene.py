@@ -147,3 +147,7 @@ def test_a_window_renders_as_that_rectangle_of_the_whole_render():
     for index, (points, _) in enumerate(scene.paths()):
         assert np.allclose(boxes[index], [*points.min(axis=0), *points.max(axis=0)])
     assert Scene(4, 4).path_boxes().shape == (0, 4)
+
+
+def test_a_scene_without_paths_has_no_elements():
+    assert Scene(4, 4).elements() == [] and Scene(4, 4).element_count == 0

@@ -81,11 +81,12 @@ def run_baseline(
 
 
 def path_count(result: Vectorized | Scene) -> int:
-    """Number of paths (a background colour or rectangle of a VectorImage is not counted)."""
+    """Number of paths: ``<path>`` elements, a compound path one (a background colour or
+    rectangle of a VectorImage is not counted)."""
     if isinstance(result, TracedSvg):
         return result.path_count
     scene = result if isinstance(result, Scene) else result.scene
-    return scene.path_count
+    return scene.element_count
 
 
 def parameter_count(result: Vectorized | Scene) -> int:

@@ -13,6 +13,13 @@ from samvg.segment.colour_split import ColourSplitSettings, colour_parts, lab_im
 from samvg.segment.impact import ImpactCanvas, filter_by_impact, keep_all, offer_best
 from samvg.segment.prompts import uncovered_prompts
 from samvg.segment.segmenter import Segmenter
+from samvg.segment.tonal import TonalSettings, tonal_regions
+
+#: Tonal regions: the blur (× the longer side), k-means clusters, and the least area kept
+#: (× the image's).
+TONAL_BLUR = 0.008
+TONAL_TONES = 6
+TONAL_MIN_AREA = 0.002
 
 
 @dataclass(frozen=True)
@@ -29,6 +36,8 @@ class SegmentSettings:
     seed: int
     colour_split: ColourSplitSettings | None = None
     """How kept masks are split into colour-coherent parts (None: not split, the paper)."""
+    tonal: TonalSettings | None = None
+    """The tonal regions offered beneath SAM's masks (None: none, without a path budget)."""
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> SegmentSettings:
@@ -42,7 +51,21 @@ class SegmentSettings:
             max_paths=options.max_paths,
             seed=config.seed,
             colour_split=colour_split_settings(config, width, height),
+            tonal=tonal_settings(config, width, height),
         )
+
+
+def tonal_settings(config: Config, width: int, height: int) -> TonalSettings | None:
+    """Tonal regions in working pixels: only under a path budget with the filter by impact on."""
+    options = config.segment
+    if config.missing.paths is None or not (options.tonal_regions and options.filter_by_impact):
+        return None
+    return TonalSettings(
+        blur=TONAL_BLUR * max(width, height),
+        tones=TONAL_TONES,
+        min_pixels=TONAL_MIN_AREA * width * height,
+        seed=config.seed,
+    )
 
 
 def colour_split_settings(
@@ -74,13 +97,15 @@ class MaskSelection:
     kept_after_filter: int
     reprompt_masks: int
     colour_parts: int = 0
+    tonal_regions: int = 0
 
 
 def select_masks(
     image: np.ndarray, segmenter: Segmenter, settings: SegmentSettings
 ) -> MaskSelection:
     """AMG → filter by impact → re-prompt SAM at the centres of large uncovered regions → filter
-    the new masks (painted beneath smaller kept masks, as they will be in area order)."""
+    the new masks (painted beneath smaller kept masks, as they will be in area order) → under a
+    path budget, the tonal regions, filtered the same way → colour-coherent parts."""
     target = to_float_rgb(image)
     amg = segmenter.automatic(image)
     candidates = [part for mask in amg for part in filled_components(mask, settings.min_pixels)]
@@ -98,6 +123,10 @@ def select_masks(
             use_filter=settings.filter_by_impact,
             below=True,
         )
+    tonal = 0
+    if settings.tonal is not None:
+        for region in tonal_regions(lab_image(target), settings.tonal):
+            tonal += canvas.offer(region, below=True).kept
     split = 0
     if settings.colour_split is not None:
         split = offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact)
@@ -112,6 +141,7 @@ def select_masks(
         kept_after_filter=len(kept),
         reprompt_masks=reprompt_masks,
         colour_parts=split,
+        tonal_regions=tonal,
     )
 
 

@@ -1,0 +1,58 @@
+"""Tonal regions: the large areas of one tone of a blurred image, as VTracer's hierarchical
+clustering finds them at a coarse setting. SAM finds objects; in a textured picture (a brick
+wall, a painting's strokes) its masks are the texture's small patches, or nothing, and a small
+path budget spent on those leaves the picture's light and dark areas out. A tonal region is a
+candidate beneath the masks, kept only if the filter by impact finds it lowers the error.
+
+The image (CIELAB) is blurred with a Gaussian of ``blur`` × its longer side, its colours are
+clustered by k-means (scikit-learn ``KMeans``) into ``tones`` clusters, and each connected area of
+one cluster, holes filled, is a region.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+from sklearn.cluster import KMeans
+
+from samvg.imaging import filled_components
+
+#: k-means is fitted on at most this many pixels (every pixel is then labelled).
+SAMPLE_PIXELS = 20000
+
+
+@dataclass(frozen=True)
+class TonalSettings:
+    """Tonal regions in working pixels."""
+
+    blur: float
+    """Pixels: the Gaussian's sigma."""
+    tones: int
+    """k-means clusters."""
+    min_pixels: float
+    """Smaller regions are left out."""
+    seed: int = 0
+
+
+def tonal_regions(lab: np.ndarray, settings: TonalSettings) -> list[np.ndarray]:
+    """The tonal regions of an (H, W, 3) CIELAB image as full-size masks, largest first."""
+    height, width = lab.shape[:2]
+    blurred = np.stack(
+        [ndimage.gaussian_filter(lab[..., channel], settings.blur) for channel in range(3)],
+        axis=-1,
+    ).reshape(-1, 3)
+    generator = np.random.default_rng(settings.seed)
+    sample = blurred[generator.choice(len(blurred), min(SAMPLE_PIXELS, len(blurred)), False)]
+    tones = min(settings.tones, len(np.unique(sample, axis=0)))
+    if tones < 2:
+        return []
+    clusters = KMeans(tones, n_init=2, random_state=settings.seed).fit(sample)
+    labels = clusters.predict(blurred).reshape(height, width)
+    regions = [
+        region
+        for tone in range(tones)
+        for region in filled_components(labels == tone, settings.min_pixels)
+    ]
+    return sorted(regions, key=lambda region: -int(np.count_nonzero(region)))
