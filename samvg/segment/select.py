@@ -123,13 +123,13 @@ def select_masks(
             use_filter=settings.filter_by_impact,
             below=True,
         )
+    split = 0
+    if settings.colour_split is not None:
+        split = offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact)
     tonal = 0
     if settings.tonal is not None:
         for region in tonal_regions(lab_image(target), settings.tonal):
             tonal += canvas.offer(region, below=True).kept
-    split = 0
-    if settings.colour_split is not None:
-        split = offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact)
     pairs = list(zip(canvas.kept_masks, canvas.impacts, strict=True))
     if settings.max_paths is not None and len(pairs) > settings.max_paths:
         pairs = sorted(pairs, key=lambda pair: -pair[1])[: settings.max_paths]
