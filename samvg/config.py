@@ -87,7 +87,7 @@ class SegmentOptions:
     """Smallest colour difference (CIELAB ΔE) that splits a mask."""
     tonal_regions: bool = True
     """Under a path budget, offer the blurred image's tonal regions (`samvg.segment.tonal`) to
-    the filter by impact as well, beneath SAM's masks."""
+    the filter by impact as well, beneath SAM's masks and their colour parts."""
 
     def __post_init__(self) -> None:
         if self.model not in SAM_MODELS:

@@ -320,8 +320,9 @@ def _finish_pass(
 
 def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineResult) -> Scene:
     """Paths the finish pass split off beyond the budget are joined into compound paths where
-    they share their paint and no area with the path below (`join_pieces`), and removed (least
-    cost first) where that is not enough; a scene short of the budget says why."""
+    they share their paint with the path below (and, when translucent, no area: `join_pieces`),
+    and removed (least cost first) where that is not enough; a scene short of the budget says
+    why."""
     scene, joined = join_pieces(scene, budget)
     result.counts["compound_joined"] = result.counts.get("compound_joined", 0) + joined
     if scene.element_count > budget:

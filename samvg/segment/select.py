@@ -13,7 +13,7 @@ from samvg.segment.colour_split import ColourSplitSettings, colour_parts, lab_im
 from samvg.segment.impact import ImpactCanvas, filter_by_impact, keep_all, offer_best
 from samvg.segment.prompts import uncovered_prompts
 from samvg.segment.segmenter import Segmenter
-from samvg.segment.tonal import TonalSettings, tonal_regions
+from samvg.segment.tonal import TonalSettings, textured, tonal_regions
 
 #: Tonal regions: the blur (× the longer side), k-means clusters, and the least area kept
 #: (× the image's).
@@ -127,7 +127,7 @@ def select_masks(
     if settings.colour_split is not None:
         split = offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact)
     tonal = 0
-    if settings.tonal is not None:
+    if settings.tonal is not None and textured(target, settings.tonal):
         for region in tonal_regions(lab_image(target), settings.tonal):
             tonal += canvas.offer(region, below=True).kept
     pairs = list(zip(canvas.kept_masks, canvas.impacts, strict=True))

@@ -137,14 +137,16 @@ class ParsedSvg:
     background_gradient: _Gradient | None = None
     joined: list[bool] = field(default_factory=list)
     """Per path, whether it is one more subpath of the ``<path>`` of the path before it (a
-    compound path, whose subpaths paint no area in common); empty for none."""
+    compound path, see `read_svg`); empty for none."""
 
 
 def read_svg(text: str) -> ParsedSvg:
     """Parse SVG text made of filled shapes into a :class:`ParsedSvg`.
 
     A full-canvas, opaque, axis-aligned ``<rect>`` drawn before any other shape becomes the
-    background (its colour, or its gradient). Anything the scene cannot represent raises
+    background (its colour, or its gradient). A ``<path>`` of several subpaths becomes a
+    compound path (``joined``) when they paint no area in common, or when its fill is opaque and
+    they all run the same way round. Anything the scene cannot represent raises
     :class:`InputError` naming the element.
     """
     root = _parse_xml(text)

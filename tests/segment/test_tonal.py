@@ -5,7 +5,7 @@ import numpy as np
 from samvg.config import Config
 from samvg.segment.colour_split import lab_image
 from samvg.segment.select import tonal_settings
-from samvg.segment.tonal import TonalSettings, tonal_regions
+from samvg.segment.tonal import TonalSettings, textured, tonal_regions
 
 SETTINGS = TonalSettings(blur=3.0, tones=4, min_pixels=200.0)
 
@@ -44,3 +44,11 @@ def test_tonal_regions_come_only_with_a_path_budget():
     assert tonal_settings(Config(paths=16, tonal_regions=False), 512, 384) is None
     settings = tonal_settings(Config(paths=16), 512, 384)
     assert settings is not None and settings.blur == 0.008 * 512
+
+
+def test_only_a_textured_image_gets_tonal_regions():
+    rng = np.random.default_rng(5)
+    noise = rng.uniform(0.0, 1.0, (128, 128, 3))
+    assert textured(noise, SETTINGS)
+    assert not textured(np.full((128, 128, 3), 0.4), SETTINGS)
+    assert textured(_bricks(), SETTINGS)  # a wall and a grainy sky
