@@ -37,7 +37,8 @@ class SegmentSettings:
     colour_split: ColourSplitSettings | None = None
     """How kept masks are split into colour-coherent parts (None: not split, the paper)."""
     tonal: TonalSettings | None = None
-    """The tonal regions offered beneath SAM's masks (None: none, without a path budget)."""
+    """The tonal regions offered beneath SAM's masks and their colour parts, to a textured
+    image (None: none, without a path budget)."""
 
     @classmethod
     def from_config(cls, config: Config, width: int, height: int) -> SegmentSettings:
@@ -104,8 +105,9 @@ def select_masks(
     image: np.ndarray, segmenter: Segmenter, settings: SegmentSettings
 ) -> MaskSelection:
     """AMG → filter by impact → re-prompt SAM at the centres of large uncovered regions → filter
-    the new masks (painted beneath smaller kept masks, as they will be in area order) → under a
-    path budget, the tonal regions, filtered the same way → colour-coherent parts."""
+    the new masks (painted beneath smaller kept masks, as they will be in area order) →
+    colour-coherent parts → under a path budget, a textured image's tonal regions, filtered the
+    same way (beneath the smaller masks and parts)."""
     target = to_float_rgb(image)
     amg = segmenter.automatic(image)
     candidates = [part for mask in amg for part in filled_components(mask, settings.min_pixels)]

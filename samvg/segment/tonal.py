@@ -2,7 +2,8 @@
 clustering finds them at a coarse setting. SAM finds objects; in a textured picture (a brick
 wall, a painting's strokes) its masks are the texture's small patches, or nothing, and a small
 path budget spent on those leaves the picture's light and dark areas out. A tonal region is a
-candidate beneath the masks, kept only if the filter by impact finds it lowers the error.
+candidate beneath the masks and their colour parts, kept only if the filter by impact finds it
+lowers the error.
 
 Only a textured image gets them: one whose JPEG complexity (Machado & Cardoso, as the bench
 measures it) is at least ``min_complexity``. On flat art and smooth wallpapers they crowded out
@@ -10,7 +11,7 @@ the small marks that stage 4 finds (debian_spacefun at 256 paths: LPIPS 0.093 ->
 stars gone); on photos, paintings and hatched line art they were the better paths
 (composition_vii at 16 paths: MSE 31.9 -> 26.3e-3, openclipart_bowsaw 3.8 -> 1.0e-3).
 
-The image (CIELAB) is blurred with a Gaussian of ``blur`` × its longer side, its colours are
+The image (CIELAB) is blurred with a Gaussian of ``blur`` pixels, its colours are
 clustered by k-means (scikit-learn ``KMeans``) into ``tones`` clusters, and each connected area of
 one cluster, holes filled, is a region.
 """
