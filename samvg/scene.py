@@ -369,6 +369,11 @@ class Scene:
         """(P,) bool: which paths are joined to the one below (`joined`, all False when None)."""
         return np.zeros(self.path_count, bool) if self.joined is None else self.joined
 
+    def joined_runs(self) -> np.ndarray:
+        """(P,) int: which run of `joined` paths each path is in, 0 first, by the flags alone
+        (`elements` also asks for one paint)."""
+        return np.cumsum(~self.joined_paths()) - 1
+
     def segment_counts(self) -> np.ndarray:
         """K of every path, (P,) int64."""
         return np.diff(self.offsets) // 3
@@ -444,8 +449,8 @@ class Scene:
         kept = self.with_paths([(self.path_points(int(i)), self.paints[int(i)]) for i in indices])
         joined = None
         if self.joined is not None and len(indices):
-            element = np.cumsum(~self.joined) - 1
-            joined = np.concatenate([[False], element[indices[1:]] == element[indices[:-1]]])
+            run = self.joined_runs()
+            joined = np.concatenate([[False], run[indices[1:]] == run[indices[:-1]]])
         return replace(kept, fixed=self.fixed_paths()[indices], joined=joined)
 
     def fixed_paths(self) -> np.ndarray:

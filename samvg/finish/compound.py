@@ -15,6 +15,7 @@ paths, and removing them to meet the budget lost real area (arctic_greyling at 1
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import replace
 
 import numpy as np
@@ -46,7 +47,7 @@ def join_pieces(scene: Scene, limit: int) -> tuple[Scene, int]:
         if joined[index] and same_paint:
             run.append(regions[index])
             continue
-        opaque = scene.paints[index].rgba[3] >= 1.0
+        opaque = scene.paints[index].opaque
         if made < excess and same_paint and (opaque or _apart(regions[index], run)):
             joined[index] = True
             run.append(regions[index])
@@ -57,7 +58,14 @@ def join_pieces(scene: Scene, limit: int) -> tuple[Scene, int]:
     return replace(scene, joined=joined), made
 
 
-def _apart(region: BaseGeometry, run: list[BaseGeometry]) -> bool:
+def pieces_apart(pieces: list[np.ndarray]) -> bool:
+    """Whether closed cubic paths ((3K, 2) control points each) paint (almost) no area in
+    common, so that one ``<path>`` of them all paints what they paint one by one."""
+    regions = path_regions(*_outlines(pieces))
+    return all(_apart(regions[index], regions[:index]) for index in range(1, len(regions)))
+
+
+def _apart(region: BaseGeometry, run: Iterable[BaseGeometry]) -> bool:
     """Whether ``region`` shares (almost) no area with any region of ``run``."""
     return all(region.intersection(other).area <= MAX_SHARED_AREA for other in run)
 
@@ -80,7 +88,10 @@ def one_way_round(pieces: list[np.ndarray]) -> bool:
 
 def _turns(pieces: list[np.ndarray]) -> np.ndarray:
     """The sign of each closed path's area: +1 clockwise on the screen, -1 the other way."""
-    points = np.concatenate(pieces)
+    return np.sign(signed_polygon_areas(*_outlines(pieces)))
+
+
+def _outlines(pieces: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The flattened outlines of closed cubic paths: vertices and vertex offsets."""
     offsets = np.cumsum([0] + [len(piece) for piece in pieces])
-    vertices, vertex_offsets = flatten_paths(points, offsets)
-    return np.sign(signed_polygon_areas(vertices, vertex_offsets))
+    return flatten_paths(np.concatenate(pieces), offsets)

@@ -23,14 +23,14 @@ def apply_edits(scene: Scene, edits: Mapping[int, Edit]) -> Scene:
         return scene
     paths: list[tuple[np.ndarray, Paint]] = []
     joined: list[bool] = []
-    element = np.cumsum(~scene.joined_paths())
-    last_element = -1
+    run = scene.joined_runs()
+    last_run = -1
     for index, (points, paint) in enumerate(scene.paths()):
         replaced = edits.get(index, [(points, paint)])
         for part, path in enumerate(replaced):
             paths.append(path)
-            joined.append(part == 0 and element[index] == last_element)
-            last_element = element[index] if part == 0 else -1
+            joined.append(part == 0 and run[index] == last_run)
+            last_run = run[index] if part == 0 else -1
     edited = scene.with_paths(paths)
     return replace(edited, joined=np.array(joined)) if scene.joined is not None else edited
 

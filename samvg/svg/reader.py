@@ -32,9 +32,7 @@ import numpy as np
 import svgelements
 
 from samvg.errors import InputError
-from samvg.finish.compound import MAX_SHARED_AREA, one_way_round
-from samvg.finish.flatten import flatten_paths
-from samvg.finish.outline import path_regions
+from samvg.finish.compound import one_way_round, pieces_apart
 from samvg.scene import LinearGradient, RadialGradient
 from samvg.svg.gradients import gradient_paint
 from samvg.svg.values import number
@@ -535,7 +533,7 @@ def _read_shape(shape: Any, scene: _Scene, opacity: float, label: str) -> None:
     if not pieces:
         raise InputError(f"{label}: path has no segments")
     opaque = fill[3] >= 1.0 if isinstance(fill, tuple) else fill.opaque
-    if len(pieces) > 1 and not ((opaque and one_way_round(pieces)) or _apart(pieces)):
+    if len(pieces) > 1 and not ((opaque and one_way_round(pieces)) or pieces_apart(pieces)):
         raise InputError(
             f"{label}: subpaths of one <path> that overlap (holes) are not supported; "
             "split them into separate paths"
@@ -654,20 +652,6 @@ def _subpaths(segments: Iterable[Any]) -> list[list[Any]]:
             found.append([])
         found[-1].append(segment)
     return found
-
-
-def _apart(pieces: list[np.ndarray]) -> bool:
-    """Whether closed cubic paths paint no area in common (a compound path's pieces; one
-    inside another would be a hole, which the scene cannot hold)."""
-    points = np.concatenate(pieces)
-    offsets = np.cumsum([0] + [len(piece) for piece in pieces])
-    vertices, vertex_offsets = flatten_paths(points, offsets)
-    regions = path_regions(vertices, vertex_offsets)
-    return all(
-        regions[a].intersection(regions[b]).area <= MAX_SHARED_AREA
-        for a in range(len(regions))
-        for b in range(a)
-    )
 
 
 def _cubic_points(segments: Iterable[Any], label: str) -> np.ndarray:
