@@ -319,12 +319,9 @@ def _finish_pass(
 
 
 def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineResult) -> Scene:
-    """Paths the finish pass split off beyond the budget are joined into compound paths where
-    they share their paint with the path below (and, when translucent, no area: `join_pieces`),
-    and removed (least cost first) where that is not enough; a scene short of the budget says
-    why."""
-    scene, joined = join_pieces(scene, budget)
-    result.counts["compound_joined"] = result.counts.get("compound_joined", 0) + joined
+    """Paths the finish pass split off beyond the budget, and could not join into compound
+    paths (`_finish_pass`'s ``join_to``), are removed (least cost first); a scene short of the
+    budget says why."""
     if scene.element_count > budget:
         scene, removed = reduce_paths(scene, inputs.target, budget)
         result.counts["reduced"] = result.counts.get("reduced", 0) + removed

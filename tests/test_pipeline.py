@@ -254,17 +254,16 @@ def test_parts_that_rounding_repairs_split_off_do_not_break_a_budget(
 def test_a_budget_keeps_a_repair_s_pieces_as_one_compound_path():
     """arctic_greyling at 16 paths lost MSE 36.7 -> 56.0e-3 when the pieces that the finish
     pass split off crossing paths were removed to meet the budget; joined, nothing is lost."""
-    from samvg.finish import finish_scene
-    from samvg.pipeline import PipelineResult, _Inputs, _meet_budget
+    from samvg.pipeline import PipelineResult, _finish_pass, _Inputs, _meet_budget
     from samvg.scene import Frame
     from tests.finish.shapes import RED, figure_eight, scene_of
 
     scene = scene_of((figure_eight(), RED))
     target = scene.render()
-    pieces = finish_scene(scene).scene
-    assert pieces.path_count == 2
     inputs = _Inputs((target * 255).astype(np.uint8), target, None, Frame(512, 512))
     result = PipelineResult(image=samvg.VectorImage(512, 512))
+    pieces = _finish_pass(scene, Config(), inputs, result, lambda *_: None, join_to=1)
+    assert pieces.path_count == 2
     met = _meet_budget(pieces, inputs, 1, result)
     assert met.element_count == 1 and met.path_count == 2
     assert result.counts["compound_joined"] == 1 and "reduced" not in result.counts
