@@ -125,12 +125,17 @@ def select_masks(
             use_filter=settings.filter_by_impact,
             below=True,
         )
+    lab = None
     split = 0
     if settings.colour_split is not None:
-        split = offer_colour_parts(canvas, settings.colour_split, settings.filter_by_impact)
+        lab = lab_image(canvas.target)
+        split = offer_colour_parts(
+            canvas, settings.colour_split, settings.filter_by_impact, lab=lab
+        )
     tonal = 0
     if settings.tonal is not None and textured(target, settings.tonal):
-        for region in tonal_regions(lab_image(target), settings.tonal):
+        lab = lab_image(canvas.target) if lab is None else lab
+        for region in tonal_regions(lab, settings.tonal):
             tonal += canvas.offer(region, below=True).kept
     pairs = list(zip(canvas.kept_masks, canvas.impacts, strict=True))
     if settings.max_paths is not None and len(pairs) > settings.max_paths:
