@@ -277,6 +277,10 @@ class MissingOptions:
     filter_speckle: int = 4
     """Marks smaller than this many pixels squared (working pixels) are speckle and never become
     paths: VTracer's ``filter_speckle``, and its default."""
+    texture_layers: bool = True
+    """Under a path budget, give a textured image's last paths (an eighth of the budget, at most
+    8) to texture layers: compound paths of the small islands of one colour that the render
+    misses (`samvg.missing.texture`)."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015

@@ -35,6 +35,7 @@ from samvg.io import read_image_with_alpha
 from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
 from samvg.missing import MissingSettings
 from samvg.missing.stage import MAX_AUTO_ROUNDS, add_missing_rounds, budget_pool
+from samvg.missing.texture import TextureSettings, add_texture_layers
 from samvg.optimize import FitSettings, fit_scene
 from samvg.optimize.fit import margin_box
 from samvg.optimize.reduce import (
@@ -48,6 +49,7 @@ from samvg.render.threads import using_render_threads
 from samvg.sam import SPECS
 from samvg.scene import FlatPaint, Frame, Scene
 from samvg.segment import Segmenter, SegmentSettings, select_masks
+from samvg.segment.tonal import textured
 from samvg.svg.writer import DEFAULT_PRECISION
 from samvg.trace.stage import (
     TraceSettings,
@@ -278,6 +280,8 @@ def _run_stages(
         scene = _finish_pass(scene, config, inputs, result, report, join_to=budget)
     if budget is not None:
         scene = _meet_budget(scene, inputs, budget, result)
+        if config.missing.texture_layers and textured(inputs.target):
+            scene = _texture(scene, inputs, budget, config, result)
     simple = config.finish.finish_pass
     whole = simple and config.finish.whole_pixels
     _finish(scene, inputs.target, result, simple, _path_limit(config), whole)
@@ -331,6 +335,17 @@ def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineRes
             "measurably (or the finish pass merged touching paths of one colour, or made a path "
             "over the whole canvas the background)"
         )
+    return scene
+
+
+def _texture(
+    scene: Scene, inputs: _Inputs, budget: int, config: Config, result: PipelineResult
+) -> Scene:
+    """A textured image's last paths under a budget as texture layers (`add_texture_layers`)."""
+    with _timed(result, "texture"):
+        settings = TextureSettings(min_pixels=config.missing.filter_speckle, seed=config.seed)
+        scene, layers = add_texture_layers(scene, inputs.target, budget, settings)
+    result.counts["texture_layers"] = layers
     return scene
 
 
@@ -512,6 +527,16 @@ def simple_when_saved(scene: Scene, precision: int = DEFAULT_PRECISION) -> Scene
     return repaired.with_geometry(np.round(repaired.points, precision))
 
 
+def _simple_within(scene: Scene, limit: int | None) -> Scene:
+    """`simple_when_saved`, with the pieces that its repairs split off joined into compound
+    paths (a texture layer's islands, a repaired path's pieces) and, where they still go over
+    ``limit`` SVG elements, the smallest removed."""
+    simple = simple_when_saved(scene)
+    if limit is not None:
+        simple, _ = join_pieces(simple, limit)
+    return _largest(simple, limit)
+
+
 def _finish(
     scene: Scene,
     target: np.ndarray,
@@ -527,7 +552,7 @@ def _finish(
     ``IDLE_COST`` are saved so (`whole_pixel_paths`, 2 % of the MSE in all)."""
     result.scene = scene
     output = scene.in_input_pixels()
-    saved = _largest(simple_when_saved(output), limit) if simple else output
+    saved = _simple_within(output, limit) if simple else output
     scale = scene.frame.scale if scene.frame is not None else 1.0
     written = saved.on_canvas(scene.width, scene.height, scale)  # the SVG at the working size
     result.mse = float(np.mean((written.render() - target) ** 2))

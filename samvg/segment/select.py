@@ -133,7 +133,7 @@ def select_masks(
             canvas, settings.colour_split, settings.filter_by_impact, lab=lab
         )
     tonal = 0
-    if settings.tonal is not None and textured(target, settings.tonal):
+    if settings.tonal is not None and textured(target, settings.tonal.min_complexity):
         lab = lab_image(canvas.target) if lab is None else lab
         for region in tonal_regions(lab, settings.tonal):
             tonal += canvas.offer(region, below=True).kept

@@ -29,6 +29,9 @@ from samvg.metrics.image_metrics import complexity
 
 #: k-means is fitted on at most this many pixels (every pixel is then labelled).
 SAMPLE_PIXELS = 20000
+#: The least JPEG complexity of a textured image: the bench's photos and paintings measure 0.20
+#: to 1.33, its hatched clipart 0.21 to 0.30, its emoji, icons and wallpapers 0.02 to 0.10.
+TEXTURED = 0.15
 
 
 @dataclass(frozen=True)
@@ -42,15 +45,14 @@ class TonalSettings:
     min_pixels: float
     """Smaller regions are left out."""
     seed: int = 0
-    min_complexity: float = 0.15
-    """The least JPEG complexity of an image that gets tonal regions: the bench's photos and
-    paintings measure 0.20 to 1.33, its hatched clipart 0.21 to 0.30, its emoji, icons and
-    wallpapers 0.02 to 0.10."""
+    min_complexity: float = TEXTURED
+    """The least JPEG complexity of an image that gets tonal regions."""
 
 
-def textured(image: np.ndarray, settings: TonalSettings) -> bool:
-    """Whether an (H, W, 3) float image in [0, 1] is textured enough for tonal regions."""
-    return complexity(image) >= settings.min_complexity
+def textured(image: np.ndarray, min_complexity: float = TEXTURED) -> bool:
+    """Whether an (H, W, 3) float image in [0, 1] is textured: its JPEG complexity is at least
+    ``min_complexity`` (also the gate of `samvg.missing.texture`)."""
+    return complexity(image) >= min_complexity
 
 
 def tonal_regions(lab: np.ndarray, settings: TonalSettings) -> list[np.ndarray]:

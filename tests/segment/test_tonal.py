@@ -49,6 +49,6 @@ def test_tonal_regions_come_only_with_a_path_budget():
 def test_only_a_textured_image_gets_tonal_regions():
     rng = np.random.default_rng(5)
     noise = rng.uniform(0.0, 1.0, (128, 128, 3))
-    assert textured(noise, SETTINGS)
-    assert not textured(np.full((128, 128, 3), 0.4), SETTINGS)
-    assert textured(_bricks(), SETTINGS)  # a wall and a grainy sky
+    assert textured(noise)
+    assert not textured(np.full((128, 128, 3), 0.4))
+    assert textured(_bricks())  # a wall and a grainy sky

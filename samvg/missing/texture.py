@@ -1,0 +1,151 @@
+"""Texture layers: under a path budget, a textured image's last paths are compound paths of many
+small islands of one colour each, laid over the fitted scene where the render misses the
+image's texture (the stones of a wall, a painting's strokes, the glints on water). This is how
+VTracer's layered output keeps a photo's texture with few ``<path>`` elements. Paths that SAM's
+masks give are smooth regions; at 64 paths kodim01's stone wall was a smooth smear, LPIPS 0.58
+against VTracer's 0.47; with 8 texture layers it is 0.35.
+
+One layer at a time: the image's colours, sampled where the render is wrong (weighted by the
+squared error), are clustered by k-means (scikit-learn ``KMeans``); the cluster colour that lowers
+the squared error on the most pixels wins. Those pixels, cleared of single-pixel noise (a 3 × 3
+median) and of islands under ``min_pixels``, are the layer: its islands of most gain are traced
+(stage 2's tracer) and joined into one compound path (`Scene.joined`) filled with their mean
+colour. A layer is kept only if the whole render's MSE drops.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy import ndimage
+from sklearn.cluster import KMeans
+
+from samvg.optimize.reduce import reduce_paths
+from samvg.scene import FlatPaint, Scene
+from samvg.trace import trace_masks
+
+#: Pixels sampled for the k-means fit of the colours the render misses.
+SAMPLE_PIXELS = 20000
+
+
+@dataclass(frozen=True)
+class TextureSettings:
+    """Texture layers in working pixels."""
+
+    share: float = 0.125
+    """The share of a path budget given to texture layers (at least one layer)."""
+    max_layers: int = 8
+    """The most texture layers (keeps the SVG small at large budgets)."""
+    islands: int = 150
+    """The most islands one layer holds (those of most gain)."""
+    colours: int = 8
+    """k-means clusters of the missed colours, each a candidate layer colour."""
+    min_pixels: float = 4.0
+    """Smaller islands are speckle (VTracer's ``filter_speckle``)."""
+    tolerance: float = 1.0
+    """The tracer's tolerance (pixels) for an island's outline."""
+    seed: int = 0
+
+    def layers(self, budget: int) -> int:
+        """Texture layers under a budget of ``budget`` paths (none under a budget of one)."""
+        if budget < 2:
+            return 0
+        return min(self.max_layers, max(1, round(budget * self.share)), budget - 1)
+
+
+def add_texture_layers(
+    scene: Scene, target: np.ndarray, budget: int, settings: TextureSettings
+) -> tuple[Scene, int]:
+    """``scene`` (within ``budget`` SVG elements) with its paths of least impact removed to make
+    room for texture layers, and the layers that lower the MSE against ``target`` (H, W, 3 float
+    in [0, 1]) laid on top; returns the scene and how many layers it gained."""
+    count = settings.layers(budget)
+    if count == 0:
+        return scene, 0
+    if scene.element_count > budget - count:
+        scene, _ = reduce_paths(scene, target, budget - count)
+    generator = np.random.default_rng(settings.seed)
+    error = _mse(scene, target)
+    added = 0
+    for _ in range(count):
+        layer = texture_layer(scene, target, settings, generator)
+        if layer is None:
+            break
+        candidate = scene.stacked(layer)
+        candidate_error = _mse(candidate, target)
+        if candidate_error >= error:
+            break
+        scene, error = candidate, candidate_error
+        added += 1
+    return scene, added
+
+
+def texture_layer(
+    scene: Scene, target: np.ndarray, settings: TextureSettings, generator: np.random.Generator
+) -> Scene | None:
+    """The next texture layer over ``scene``'s render: a scene of islands of one flat colour,
+    each joined to the one below into one compound path (None: nothing worth a layer)."""
+    squared = ((target - scene.render()) ** 2).sum(axis=2)
+    mask = _best_colour_mask(squared, target, settings, generator)
+    if mask is None:
+        return None
+    labels, count = ndimage.label(mask)
+    indices = np.arange(1, count + 1)
+    areas = ndimage.sum_labels(mask, labels, indices)
+    gains = ndimage.sum_labels(
+        squared - _squared_to(target, target[mask].mean(axis=0)), labels, indices
+    )
+    wanted = indices[(areas >= settings.min_pixels) & (gains > 0)]
+    wanted = wanted[np.argsort(-gains[wanted - 1], kind="stable")[: settings.islands]]
+    if len(wanted) == 0:
+        return None
+    islands = np.isin(labels, wanted)
+    colour = target[islands].mean(axis=0)
+    traced = trace_masks(
+        [islands], target, min_area=settings.min_pixels, tolerance=settings.tolerance
+    )
+    if traced.path_count == 0:
+        return None
+    paint = FlatPaint((float(colour[0]), float(colour[1]), float(colour[2]), 1.0))
+    layer = replace(traced, paints=(paint,) * traced.path_count)
+    joined = np.ones(layer.path_count, dtype=bool)
+    joined[0] = False
+    return replace(layer, joined=joined)
+
+
+def _best_colour_mask(
+    squared: np.ndarray,
+    target: np.ndarray,
+    settings: TextureSettings,
+    generator: np.random.Generator,
+) -> np.ndarray | None:
+    """The pixels that the candidate colour of most total gain paints better than the render,
+    single-pixel noise removed (None when the render is exact)."""
+    weights = squared.reshape(-1).astype(np.float64)
+    if weights.sum() <= 0:
+        return None
+    pixels = target.reshape(-1, 3)
+    picked = generator.choice(
+        len(pixels), min(SAMPLE_PIXELS, len(pixels)), p=weights / weights.sum()
+    )
+    sample = pixels[picked]
+    clusters = min(settings.colours, len(np.unique(sample, axis=0)))
+    centres = KMeans(clusters, n_init=1, random_state=settings.seed).fit(sample).cluster_centers_
+    best, best_gain = None, 0.0
+    for centre in centres:
+        gain = squared - _squared_to(target, centre)
+        mask = ndimage.median_filter(gain > 0, size=3)
+        total = float(gain[mask].sum())
+        if total > best_gain:
+            best, best_gain = mask, total
+    return best
+
+
+def _squared_to(target: np.ndarray, colour: np.ndarray) -> np.ndarray:
+    """Per pixel, the squared distance (summed over RGB) from ``target`` to one colour."""
+    return ((target - colour) ** 2).sum(axis=2)
+
+
+def _mse(scene: Scene, target: np.ndarray) -> float:
+    return float(np.mean((scene.render() - target) ** 2))
