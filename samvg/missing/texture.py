@@ -10,7 +10,10 @@ squared error), are clustered by k-means (scikit-learn ``KMeans``); the cluster 
 the squared error on the most pixels wins. Those pixels, cleared of single-pixel noise (a 3 × 3
 median) and of islands under ``min_pixels``, are the layer: its islands of most gain are traced
 (stage 2's tracer) and joined into one compound path (`Scene.joined`) filled with their mean
-colour. A layer is kept only if the whole render's MSE drops.
+colour. Where the budget is full, a layer takes the place of the path of least impact beneath
+the layers (`reduce_paths`), and is kept only if the whole render's MSE drops: on hatched line
+art (arctic_greyling at 16 paths) the two paths a layer would replace mattered more (MSE 35.2
+-> 57.6e-3 when room was made first and the layers then found no gain).
 """
 
 from __future__ import annotations
@@ -57,28 +60,27 @@ class TextureSettings:
 def add_texture_layers(
     scene: Scene, target: np.ndarray, budget: int, settings: TextureSettings
 ) -> tuple[Scene, int]:
-    """``scene`` (within ``budget`` SVG elements) with its paths of least impact removed to make
-    room for texture layers, and the layers that lower the MSE against ``target`` (H, W, 3 float
-    in [0, 1]) laid on top; returns the scene and how many layers it gained."""
-    count = settings.layers(budget)
-    if count == 0:
-        return scene, 0
-    if scene.element_count > budget - count:
-        scene, _ = reduce_paths(scene, target, budget - count)
+    """``scene`` (within ``budget`` SVG elements) with texture layers laid on top, each one in
+    exchange for the path of least impact beneath them where the budget is full, and kept only
+    if the exchange lowers the MSE against ``target`` (H, W, 3 float in [0, 1]); returns the
+    scene and how many layers it gained."""
     generator = np.random.default_rng(settings.seed)
+    base, layers = scene, scene.subset([])
     error = _mse(scene, target)
-    added = 0
-    for _ in range(count):
-        layer = texture_layer(scene, target, settings, generator)
+    for _ in range(settings.layers(budget)):
+        current = base.stacked(layers)
+        layer = texture_layer(current, target, settings, generator)
         if layer is None:
             break
-        candidate = scene.stacked(layer)
+        room = base
+        if current.element_count >= budget:
+            room, _ = reduce_paths(base, target, base.element_count - 1)
+        candidate = room.stacked(layers).stacked(layer)
         candidate_error = _mse(candidate, target)
         if candidate_error >= error:
             break
-        scene, error = candidate, candidate_error
-        added += 1
-    return scene, added
+        base, layers, error = room, layers.stacked(layer), candidate_error
+    return base.stacked(layers), layers.element_count
 
 
 def texture_layer(
