@@ -281,7 +281,7 @@ def _run_stages(
     if budget is not None:
         scene = _meet_budget(scene, inputs, budget, result)
         if config.missing.texture_layers and textured(inputs.target):
-            scene = _texture(scene, inputs, budget, config, result)
+            scene = _texture(scene, inputs, budget, config, result, report)
     simple = config.finish.finish_pass
     whole = simple and config.finish.whole_pixels
     _finish(scene, inputs.target, result, simple, _path_limit(config), whole)
@@ -339,12 +339,19 @@ def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineRes
 
 
 def _texture(
-    scene: Scene, inputs: _Inputs, budget: int, config: Config, result: PipelineResult
+    scene: Scene,
+    inputs: _Inputs,
+    budget: int,
+    config: Config,
+    result: PipelineResult,
+    report: ProgressCallback,
 ) -> Scene:
     """A textured image's last paths under a budget as texture layers (`add_texture_layers`)."""
     with _timed(result, "texture"):
+        report("texture", 0, 1)
         settings = TextureSettings(min_pixels=config.missing.filter_speckle, seed=config.seed)
         scene, layers = add_texture_layers(scene, inputs.target, budget, settings)
+        report("texture", 1, 1)
     result.counts["texture_layers"] = layers
     return scene
 

@@ -267,3 +267,17 @@ def test_a_budget_keeps_a_repair_s_pieces_as_one_compound_path():
     met = _meet_budget(pieces, inputs, 1, result)
     assert met.element_count == 1 and met.path_count == 2
     assert result.counts["compound_joined"] == 1 and "reduced" not in result.counts
+
+
+@pytest.mark.slow
+def test_a_photo_s_last_paths_under_a_budget_are_texture_layers(bench_dir, sam_checkpoint):
+    photo = read_image(bench_dir / "photo" / "kodim01.png")
+    photo = np.asarray(Image.fromarray(photo).resize((192, 128), Image.Resampling.LANCZOS))
+    base = {**QUICK, "checkpoint": str(sam_checkpoint), "paths": 8}
+    plain = samvg.run(photo, Config(texture_layers=False, **base))
+    layered = samvg.run(photo, Config(**base))
+    assert "texture_layers" not in plain.counts
+    assert layered.counts["texture_layers"] == 1 and layered.counts["paths"] == 8
+    assert layered.counts["shapes"] > plain.counts["shapes"] + 10  # one layer of many islands
+    assert layered.mse < plain.mse
+    assert layered.image.to_svg().count("<path") == 8
