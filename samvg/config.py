@@ -279,7 +279,7 @@ class MissingOptions:
     paths: VTracer's ``filter_speckle``, and its default."""
     texture_layers: bool = True
     """Under a path budget, give a textured image's last paths (an eighth of the budget, at most
-    8) to texture layers: compound paths of the small islands of one colour that the render
+    16) to texture layers: compound paths of the small islands of one colour that the render
     misses (`samvg.missing.texture`)."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""

@@ -25,7 +25,7 @@ def _mse(scene: Scene, target: np.ndarray) -> float:
 
 def test_the_layers_a_budget_gets():
     settings = TextureSettings()
-    assert [settings.layers(n) for n in (1, 2, 8, 16, 64, 256)] == [0, 1, 1, 2, 8, 8]
+    assert [settings.layers(n) for n in (1, 2, 8, 16, 64, 256)] == [0, 1, 1, 2, 8, 16]
 
 
 def test_layers_of_islands_lower_a_photo_s_error(wall):
