@@ -161,6 +161,8 @@ def _config(arguments: argparse.Namespace) -> Config:
         settings["gradients"] = arguments.gradients
     if arguments.no_finish:
         settings["finish_pass"] = False
+    if arguments.no_texture:
+        settings["texture_layers"] = False
     preset = "fast" if arguments.fast else arguments.preset
     return PRESETS[preset](**settings)
 
@@ -485,6 +487,12 @@ def _add_shape_options(vectorize: argparse.ArgumentParser) -> None:
         action=argparse.BooleanOptionalAction,
         help="let paths and the background take linear or radial gradient fills where they pay "
         "for their parameters (the default; --no-gradients keeps every fill flat, as the paper)",
+    )
+    vectorize.add_argument(
+        "--no-texture",
+        action="store_true",
+        help="with --paths, keep a photo's or painting's last paths as plain shapes instead of "
+        "texture layers (compound paths of many small islands of one colour)",
     )
     vectorize.add_argument(
         "--no-finish",

@@ -232,3 +232,13 @@ def test_gradient_fills_can_be_asked_for_or_refused():
     assert config("--no-gradients").fit.gradients is False
     assert config().fit.gradients == Config().fit.gradients
     assert config("--preset", "paper", "--gradients").fit.gradients is True
+
+
+def test_texture_layers_can_be_refused():
+    from samvg.cli import _config, build_parser
+
+    def config(*options: str):
+        return _config(build_parser().parse_args(["vectorize", "in.png", "-o", "o.svg", *options]))
+
+    assert config("--paths", "16").missing.texture_layers is True
+    assert config("--paths", "16", "--no-texture").missing.texture_layers is False
