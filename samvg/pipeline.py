@@ -350,7 +350,8 @@ def _texture(
     with _timed(result, "texture"):
         report("texture", 0, 1)
         settings = TextureSettings(min_pixels=config.missing.filter_speckle, seed=config.seed)
-        scene, layers = add_texture_layers(scene, inputs.target, budget, settings)
+        opaque = None if inputs.alpha is None else inputs.alpha >= 0.5
+        scene, layers = add_texture_layers(scene, inputs.target, budget, settings, opaque)
         report("texture", 1, 1)
     result.counts["texture_layers"] = layers
     return scene

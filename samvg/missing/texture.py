@@ -59,12 +59,17 @@ class TextureSettings:
 
 
 def add_texture_layers(
-    scene: Scene, target: np.ndarray, budget: int, settings: TextureSettings
+    scene: Scene,
+    target: np.ndarray,
+    budget: int,
+    settings: TextureSettings,
+    opaque: np.ndarray | None = None,
 ) -> tuple[Scene, int]:
     """``scene`` (within ``budget`` SVG elements) with texture layers laid on top, each one in
     exchange for the element of least removal cost beneath them where the budget is full, and
     kept only if the exchange lowers the MSE against ``target`` (H, W, 3 float in [0, 1]);
-    returns the scene and how many layers it gained."""
+    returns the scene and how many layers it gained. With ``opaque`` ((H, W) bool, an input with
+    transparency), islands lie only where it is True."""
     generator = np.random.default_rng(settings.seed)
     runs = scene.joined_runs()
     cheapest: list[int] = []
@@ -80,7 +85,8 @@ def add_texture_layers(
                 cheapest = np.argsort(costs, kind="stable").tolist()
             out = [*removed, cheapest[len(removed)]]
             room = scene.subset(np.flatnonzero(~np.isin(runs, out)))
-        found = _best_exchange(current, room.stacked(layers), target, settings, generator)
+        under = room.stacked(layers)
+        found = _best_exchange(current, under, target, settings, generator, opaque)
         if found is None or found[1] >= error:
             break
         layer, error = found
@@ -94,6 +100,7 @@ def _best_exchange(
     target: np.ndarray,
     settings: TextureSettings,
     generator: np.random.Generator,
+    opaque: np.ndarray | None,
 ) -> tuple[Scene, float] | None:
     """The next layer laid over ``under`` (``current`` less the element the layer replaces, or
     ``current`` itself) and the MSE it leaves. Where an element goes, the layer is drawn both
@@ -103,7 +110,7 @@ def _best_exchange(
     drawn_over = [under] if under.path_count == current.path_count else [under, current]
     best: tuple[Scene, float] | None = None
     for scene in drawn_over:
-        layer = texture_layer(scene, target, settings, generator)
+        layer = texture_layer(scene, target, settings, generator, opaque)
         if layer is None:
             continue
         error = _mse(under.stacked(layer), target)
@@ -113,11 +120,18 @@ def _best_exchange(
 
 
 def texture_layer(
-    scene: Scene, target: np.ndarray, settings: TextureSettings, generator: np.random.Generator
+    scene: Scene,
+    target: np.ndarray,
+    settings: TextureSettings,
+    generator: np.random.Generator,
+    opaque: np.ndarray | None = None,
 ) -> Scene | None:
     """The next texture layer over ``scene``'s render: a scene of islands of one flat colour,
-    each joined to the one below into one compound path (None: nothing worth a layer)."""
+    each joined to the one below into one compound path (None: nothing worth a layer), only
+    where ``opaque`` is True when given."""
     squared = ((target - scene.render()) ** 2).sum(axis=2)
+    if opaque is not None:  # no gain where the input is transparent: no island there
+        squared = np.where(opaque, squared, 0.0)
     mask = _best_colour_mask(squared, target, settings, generator)
     if mask is None:
         return None

@@ -66,3 +66,14 @@ def test_pieces_that_rounding_s_repair_splits_off_stay_in_their_compound_path():
     scene = scene_of((figure_eight(), RED))
     saved = _simple_within(scene, 1)
     assert saved.path_count == 2 and saved.element_count == 1
+
+
+def test_islands_stay_where_the_input_is_opaque(wall):
+    opaque = np.zeros(wall.shape[:2], dtype=bool)
+    opaque[:, 96:] = True  # the left half transparent
+    flat = Scene(192, 128, background=tuple(wall.reshape(-1, 3).mean(axis=0)))
+    scene, layers = add_texture_layers(flat, wall, 16, TextureSettings(), opaque)
+    assert layers >= 1
+    changed = np.abs(scene.render() - flat.render()).sum(axis=2) > 1e-3
+    assert changed[:, 96:].mean() > 0.2
+    assert not changed[:, :94].any()  # a median's pixel, an outline's half pixel
