@@ -281,3 +281,4 @@ def test_a_photo_s_last_paths_under_a_budget_are_texture_layers(bench_dir, sam_c
     assert layered.counts["shapes"] > plain.counts["shapes"] + 10  # one layer of many islands
     assert layered.mse < plain.mse
     assert layered.image.to_svg().count("<path") == 8
+    assert any(note.startswith("texture: 1 layer, ") for note in layered.notes)
