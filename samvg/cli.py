@@ -295,7 +295,8 @@ def _vectorize_one(
         shapes = f" ({scene.path_count} shapes)" if scene.path_count != scene.element_count else ""
         _say(
             console,
-            f"wrote {output}: {scene.element_count} paths{shapes}, MSE {result.mse:.5f}, "
+            f"wrote {output}: {scene.element_count} path{'' if scene.element_count == 1 else 's'}"
+            f"{shapes}, MSE {result.mse:.5f}, "
             f"{time.perf_counter() - started:.1f}s ({timings})",
         )
         if preview is not None:

@@ -354,6 +354,8 @@ def _texture(
         scene, layers = add_texture_layers(scene, inputs.target, budget, settings, opaque)
         report("texture", 1, 1)
     result.counts["texture_layers"] = layers
+    if not settings.layers(budget):
+        return scene
     islands = sum(len(element) for element in scene.elements()[-layers:]) if layers else 0
     plural = "" if layers == 1 else "s"
     result.notes.append(f"texture: {layers} layer{plural}, {islands} islands in all")
