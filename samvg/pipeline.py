@@ -349,7 +349,7 @@ def _texture(
     """A textured image's last paths under a budget as texture layers (`add_texture_layers`)."""
     with _timed(result, "texture"):
         report("texture", 0, 1)
-        settings = TextureSettings(min_pixels=config.missing.filter_speckle, seed=config.seed)
+        settings = TextureSettings(seed=config.seed)
         opaque = None if inputs.alpha is None else inputs.alpha >= 0.5
         scene, layers = add_texture_layers(scene, inputs.target, budget, settings, opaque)
         report("texture", 1, 1)

@@ -46,7 +46,10 @@ class TextureSettings:
     colours: int = 8
     """k-means clusters of the missed colours, each a candidate layer colour."""
     min_pixels: float = 4.0
-    """Smaller islands are speckle (VTracer's ``filter_speckle``)."""
+    """Smaller islands are left out: 2 × 2 pixels, a finer grain than the marks' speckle filter
+    (`MissingOptions.filter_speckle`, 4 × 4 as VTracer's): at 16 pixels, kodim01 at 64 paths
+    kept 237 shapes in place of 1282 (LPIPS 0.31 -> 0.48), great_wave's LPIPS went 0.29 -> 0.31
+    and kodim04's 0.30 -> 0.33."""
     tolerance: float = 1.0
     """The tracer's tolerance (pixels) for an island's outline."""
     seed: int = 0
