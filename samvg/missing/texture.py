@@ -11,10 +11,10 @@ one that paints its pixels better than the render with the most gain in all wins
 cleared of single-pixel noise (a 3 × 3 median) and of islands under ``min_pixels``, are the
 layer: its islands of most gain are traced (stage 2's tracer) and joined into one compound path
 (`Scene.joined`) filled with their mean colour. Where the budget is full, a layer takes the
-place of the path of least impact beneath the layers (`reduce_paths`), and is kept only if the
-whole render's MSE drops: on hatched line art (arctic_greyling at 16 paths) the two paths that
-the layers replaced mattered more (MSE 35.2 -> 57.6e-3 when room for all the layers was made
-first and they then found no gain).
+place of the element of least removal cost beneath the layers (`removal_costs`, summed over an
+element's pieces, measured once), and is kept only if the whole render's MSE drops: on hatched
+line art (arctic_greyling at 16 paths) the two paths that the layers replaced mattered more
+(MSE 35.2 -> 57.6e-3 when room for all the layers was made first and they then found no gain).
 """
 
 from __future__ import annotations
