@@ -492,8 +492,8 @@ def _add_shape_options(vectorize: argparse.ArgumentParser) -> None:
     vectorize.add_argument(
         "--no-texture",
         action="store_true",
-        help="with --paths, keep a photo's or painting's last paths as plain shapes instead of "
-        "texture layers (compound paths of many small islands of one colour)",
+        help="no texture layers over a photo or painting (compound paths of many small islands "
+        "of one colour; with --paths they are its last paths)",
     )
     vectorize.add_argument(
         "--no-finish",

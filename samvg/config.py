@@ -278,9 +278,10 @@ class MissingOptions:
     """Marks smaller than this many pixels squared (working pixels) are speckle and never become
     paths: VTracer's ``filter_speckle``, and its default."""
     texture_layers: bool = True
-    """Under a path budget, give a textured image's last paths (an eighth of the budget, at most
-    16) to texture layers: compound paths of the small islands of one colour that the render
-    misses (`samvg.missing.texture`)."""
+    """Lay texture layers over a textured image (photos, paintings, hatched line art): compound
+    paths of the small islands of one colour that the render misses (`samvg.missing.texture`),
+    at most 16. Under a path budget they are its last paths (an eighth of it); without one, each
+    is kept only if it lowers the error by the ``detail`` tolerance, as a stage-4 round."""
     missing_threshold: float = 0.784
     """ω of the paper, on the disc-averaged sum over RGB of |I − I′| (values in [0, 3])."""
     missing_radius: float = 0.015
@@ -454,9 +455,16 @@ PAPER: dict[str, Any] = {
     "gradient_ramp": 0.0,
     "coarse_fraction": 0.0,
     "plateau_steps": None,
+    "texture_layers": False,
 }
 #: How `Config.fast` differs from the default.
-FAST: dict[str, Any] = {"points_per_side": 8, "size": 384, "iterations": 120, "use_lpips": False}
+FAST: dict[str, Any] = {
+    "points_per_side": 8,
+    "size": 384,
+    "iterations": 120,
+    "use_lpips": False,
+    "texture_layers": False,
+}
 #: The presets by name, as ``--preset`` knows them: each builds a `Config` from overrides.
 PRESETS: dict[str, Callable[..., Config]] = {
     "default": Config,

@@ -280,8 +280,8 @@ def _run_stages(
         scene = _finish_pass(scene, config, inputs, result, report, join_to=budget)
     if budget is not None:
         scene = _meet_budget(scene, inputs, budget, result)
-        if config.missing.texture_layers and textured(inputs.target):
-            scene = _texture(scene, inputs, budget, config, result, report)
+    if config.missing.texture_layers and textured(inputs.target):
+        scene = _texture(scene, inputs, budget, config, result, report)
     simple = config.finish.finish_pass
     whole = simple and config.finish.whole_pixels
     _finish(scene, inputs.target, result, simple, _path_limit(config), whole)
@@ -341,20 +341,24 @@ def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineRes
 def _texture(
     scene: Scene,
     inputs: _Inputs,
-    budget: int,
+    budget: int | None,
     config: Config,
     result: PipelineResult,
     report: ProgressCallback,
 ) -> Scene:
-    """A textured image's last paths under a budget as texture layers (`add_texture_layers`)."""
+    """A textured image's texture layers (`add_texture_layers`): under a budget its last paths;
+    without one, on top of the paths, each kept only if it lowers the error by the ``--detail``
+    tolerance (as a round of stage 4 must)."""
     with _timed(result, "texture"):
         report("texture", 0, 1)
         settings = TextureSettings(seed=config.seed)
         opaque = None if inputs.alpha is None else inputs.alpha >= 0.5
-        scene, layers = add_texture_layers(scene, inputs.target, budget, settings, opaque)
+        room = budget if budget is not None else scene.element_count + settings.max_layers
+        min_gain = 0.0 if budget is not None else config.missing.gain_tolerance
+        scene, layers = add_texture_layers(scene, inputs.target, room, settings, opaque, min_gain)
         report("texture", 1, 1)
     result.counts["texture_layers"] = layers
-    if not settings.layers(budget):
+    if budget is not None and not settings.layers(budget):
         return scene
     islands = sum(len(element) for element in scene.elements()[-layers:]) if layers else 0
     plural = "" if layers == 1 else "s"

@@ -282,3 +282,22 @@ def test_a_photo_s_last_paths_under_a_budget_are_texture_layers(bench_dir, sam_c
     assert layered.mse < plain.mse
     assert layered.image.to_svg().count("<path") == 8
     assert any(note.startswith("texture: 1 layer, ") for note in layered.notes)
+
+
+@pytest.mark.slow
+def test_without_a_budget_texture_layers_go_on_top_while_they_pay(bench_dir, sam_checkpoint):
+    photo = read_image(bench_dir / "photo" / "kodim01.png")
+    photo = np.asarray(Image.fromarray(photo).resize((192, 128), Image.Resampling.LANCZOS))
+    base = {**QUICK, "checkpoint": str(sam_checkpoint)}
+    plain = samvg.run(photo, Config(texture_layers=False, **base))
+    layered = samvg.run(photo, Config(**base))
+    layers = layered.counts["texture_layers"]
+    assert 1 <= layers <= 16
+    assert layered.counts["paths"] == plain.counts["paths"] + layers
+    assert layered.mse < plain.mse * (1 - Config().missing.gain_tolerance) ** layers
+
+
+def test_the_fast_and_paper_presets_have_no_texture_layers():
+    assert Config().missing.texture_layers
+    assert not Config.fast().missing.texture_layers
+    assert not Config.paper().missing.texture_layers

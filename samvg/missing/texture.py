@@ -67,12 +67,14 @@ def add_texture_layers(
     budget: int,
     settings: TextureSettings,
     opaque: np.ndarray | None = None,
+    min_gain: float = 0.0,
 ) -> tuple[Scene, int]:
     """``scene`` (within ``budget`` SVG elements) with texture layers laid on top, each one in
     exchange for the element of least removal cost beneath them where the budget is full, and
     kept only if the exchange lowers the MSE against ``target`` (H, W, 3 float in [0, 1]);
     returns the scene and how many layers it gained. With ``opaque`` ((H, W) bool, an input with
-    transparency), islands lie only where it is True."""
+    transparency), islands lie only where it is True; with ``min_gain``, a layer must lower the
+    MSE by that fraction."""
     generator = np.random.default_rng(settings.seed)
     runs = scene.joined_runs()
     cheapest: list[int] = []
@@ -90,7 +92,7 @@ def add_texture_layers(
             room = scene.subset(np.flatnonzero(~np.isin(runs, out)))
         under = room.stacked(layers)
         found = _best_exchange(current, under, target, settings, generator, opaque)
-        if found is None or found[1] >= error:
+        if found is None or found[1] >= error * (1.0 - min_gain):
             break
         layer, error = found
         base, layers, removed = room, layers.stacked(layer), out
