@@ -546,11 +546,11 @@ def simple_when_saved(scene: Scene, precision: int = DEFAULT_PRECISION) -> Scene
 
 def _simple_within(scene: Scene, limit: int | None) -> Scene:
     """`simple_when_saved`, with the pieces that its repairs split off joined into compound
-    paths (a texture layer's islands, a repaired path's pieces) and, where they still go over
-    ``limit`` SVG elements, the smallest removed."""
+    paths (a texture layer's islands, a repaired path's pieces) up to ``limit`` SVG elements
+    (None: as many as ``scene`` had) and, where they still go over ``limit``, the smallest
+    removed."""
     simple = simple_when_saved(scene)
-    if limit is not None:
-        simple, _ = join_pieces(simple, limit)
+    simple, _ = join_pieces(simple, scene.element_count if limit is None else limit)
     return _largest(simple, limit)
 
 

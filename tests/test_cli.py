@@ -106,7 +106,7 @@ def test_vectorize_bundled_sample_end_to_end(tmp_path, sam_checkpoint):
     result = VectorImage.load(output)
     target = read_image(SAMPLE).astype(np.float32) / 255.0
     assert (result.width, result.height) == (512, 280)
-    assert 5 <= len(result.paths) <= 150
+    assert 5 <= result.scene.element_count <= 150
     # issue 11's size goal: at most a third of VTracer's default SVG (191 KB, 100 paths)
     assert output.stat().st_size <= 191_000 / 3
     mse = float(np.mean((result.render() - target) ** 2))

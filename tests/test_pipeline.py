@@ -33,7 +33,8 @@ def test_pipeline_stages_on_real_image(emoji, sam_checkpoint):
     target = emoji.astype(np.float32) / 255.0
     assert {"segment", "trace", "optimize", "missing", "finish"} <= set(stages)
     assert result.counts["amg_masks"] >= result.counts["kept_masks"] >= 1
-    assert len(result.image.paths) == result.counts["paths"] >= 3
+    assert result.image.scene.element_count == result.counts["paths"] >= 3
+    assert len(result.image.paths) == result.counts["shapes"]
     assert len({path.num_segments for path in result.image.paths}) > 1  # chosen per outline
     rendered = result.image.render()
     mse = float(np.mean((rendered - target) ** 2))

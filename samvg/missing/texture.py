@@ -158,7 +158,8 @@ def texture_layer(
     if traced.path_count == 0:
         return None
     paint = FlatPaint((float(colour[0]), float(colour[1]), float(colour[2]), 1.0))
-    layer = replace(traced, paints=(paint,) * traced.path_count)
+    inside = np.clip(traced.points, 0.0, [traced.width, traced.height])  # handles past the edge
+    layer = replace(traced.with_geometry(inside), paints=(paint,) * traced.path_count)
     joined = np.ones(layer.path_count, dtype=bool)
     joined[0] = False
     return replace(layer, joined=joined)

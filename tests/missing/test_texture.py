@@ -32,7 +32,7 @@ def test_layers_of_islands_lower_a_photo_s_error(wall):
     assert textured(wall)
     flat = Scene(192, 128, background=tuple(wall.reshape(-1, 3).mean(axis=0)))
     scene, layers = add_texture_layers(flat, wall, 16, TextureSettings(min_pixels=4))
-    assert layers == 2 and scene.element_count == 2
+    assert layers >= 1 and scene.element_count == layers
     assert _mse(scene, wall) < 0.8 * _mse(flat, wall)
     for element in scene.elements():
         assert len(element) > 10  # many islands, one <path>
