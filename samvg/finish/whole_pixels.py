@@ -2,11 +2,10 @@
 the picture by less than a tolerance is saved that way (a number without decimals is two or
 three characters shorter, a quarter of the path's bytes).
 
-The change is measured like an idle path's (`samvg.optimize.reduce.window_change`: the mean
-squared change of the render, on the path's own window) at the working size, smallest first,
-each measured again against the paths rounded before it; the changes together stay within a
-budget (a share of the scene's MSE), and a path that rounding would make cross itself keeps
-its decimals.
+The change is the mean squared change of the render at the working size, measured by the
+greedy step of idle edits (`samvg.optimize.batches`: smallest first, each measured again
+against the paths rounded before it); the changes together stay within a budget (a share of
+the scene's MSE), and a path that rounding would make cross itself keeps its decimals.
 """
 
 from __future__ import annotations
@@ -14,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from samvg.finish.simplicity import crossing_paths
-from samvg.optimize.reduce import IDLE_COST, smallest_changes_first, window_change
+from samvg.optimize.batches import padded_windows, smallest_changes_in_batches
+from samvg.optimize.reduce import IDLE_COST, WINDOW_PAD
 from samvg.scene import Scene
 
 #: The most the picture may change from all roundings together, as a share of the scene's MSE.
@@ -32,38 +32,45 @@ def whole_pixel_paths(
     height and the factor from the SVG's pixels to it) rounded, until the changes add up to
     ``budget``; returns it and how many paths were rounded."""
     rounded = np.rint(scene.points)
-    width, height, factor = working
     crossing = set(crossing_paths(scene.with_geometry(rounded)).tolist())
-    candidates = [
-        index
-        for index in range(scene.path_count)
-        if index not in crossing
-        and not np.array_equal(scene.path_points(index), _part(rounded, scene, index))
-    ]
-    if not candidates:
+    candidates = np.array(
+        [
+            index
+            for index in range(scene.path_count)
+            if index not in crossing
+            and not np.array_equal(scene.path_points(index), _part(rounded, scene, index))
+        ],
+        dtype=np.int64,
+    )
+    if not len(candidates):
         return scene, 0
-    current = scene.on_canvas(width, height, factor)
-    boxes = current.path_boxes()
-    kept = np.ones(scene.path_count, dtype=bool)
-    points = scene.points.copy()
+    width, height, factor = working
+    canvas = scene.on_canvas(width, height, factor)
+    goal = rounded * factor
+    now, then = canvas.path_boxes(), canvas.with_geometry(goal).path_boxes()
+    both = np.concatenate(
+        [np.minimum(now[:, :2], then[:, :2]), np.maximum(now[:, 2:], then[:, 2:])], 1
+    )
+    windows = padded_windows(both[candidates], WINDOW_PAD, width, height)
 
-    def change_of(candidate: int) -> float:
-        index = candidates[candidate]
-        return window_change(current, boxes, kept, index, _part(rounded, scene, index) * factor)
+    def edited(current: Scene, members: np.ndarray) -> Scene:
+        return _with_rows(current, goal, candidates[members])
 
-    def round_path(candidate: int) -> None:
-        nonlocal current
-        index = candidates[candidate]
-        replacement = _part(rounded, scene, index) * factor
+    chosen = candidates[smallest_changes_in_batches(canvas, windows, edited, tolerance, budget)]
+    if not len(chosen):
+        return scene, 0
+    return scene.with_geometry(_with_rows(scene, rounded, chosen).points), len(chosen)
+
+
+def _with_rows(scene: Scene, points: np.ndarray, paths: np.ndarray) -> Scene:
+    """``scene`` with the rows of ``paths`` taken from ``points`` (laid out as its own)."""
+    if not len(paths):
+        return scene
+    moved = scene.points.copy()
+    for index in paths:
         start, end = scene.offsets[index], scene.offsets[index + 1]
-        points[start:end] = rounded[start:end]
-        moved = current.points.copy()
-        moved[start:end] = replacement
-        current = current.with_geometry(moved)
-        boxes[index] = np.concatenate([replacement.min(axis=0), replacement.max(axis=0)])
-
-    count, _ = smallest_changes_first(len(candidates), change_of, round_path, tolerance, budget)
-    return (scene.with_geometry(points) if count else scene), count
+        moved[start:end] = points[start:end]
+    return scene.with_geometry(moved)
 
 
 def _part(points: np.ndarray, scene: Scene, index: int) -> np.ndarray:

@@ -19,6 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from samvg.optimize.batches import padded_windows, smallest_changes_in_batches
 from samvg.scene import FlatPaint, Paint, Scene
 
 #: The mean squared change of the picture below which a path is idle: on a 512² canvas, a
@@ -313,17 +314,28 @@ def remove_idle_paths(
     before it (two copies of one path each change nothing alone; the second then changes the
     picture and stays). The change, not the error: a path that raises the MSE may still be what
     the LPIPS term of the fit put there."""
-    kept = np.ones(scene.path_count, dtype=bool)
-    boxes = scene.path_boxes()
-
-    def remove(index: int) -> None:
-        kept[index] = False
-
-    removed, _ = smallest_changes_first(
-        scene.path_count,
-        lambda index: window_change(scene, boxes, kept, index),
-        remove,
+    windows = padded_windows(scene.path_boxes(), WINDOW_PAD, scene.width, scene.height)
+    removed = smallest_changes_in_batches(
+        scene,
+        windows,
+        _collapsed,
         tolerance,
         lambda: share * float(np.mean((scene.render() - target) ** 2)),
     )
-    return (scene.subset(np.flatnonzero(kept)) if removed else scene), removed
+    if not len(removed):
+        return scene, 0
+    kept = np.ones(scene.path_count, dtype=bool)
+    kept[removed] = False
+    return scene.subset(np.flatnonzero(kept)), len(removed)
+
+
+def _collapsed(scene: Scene, paths: np.ndarray) -> Scene:
+    """``scene`` with ``paths`` drawn as nothing (each outline collapsed onto its first point:
+    no area, so no pixel of it shows), the other paths keeping their indices."""
+    if not len(paths):
+        return scene
+    points = scene.points.copy()
+    for index in paths:
+        start, end = scene.offsets[index], scene.offsets[index + 1]
+        points[start:end] = points[start]
+    return scene.with_geometry(points)

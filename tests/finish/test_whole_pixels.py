@@ -57,3 +57,33 @@ def test_a_scene_already_in_whole_pixels_is_returned_as_it_is():
     scene = Scene.from_paths(64, 64, [(square(3, 3, 30), BLACK)], background=(1.0, 1.0, 1.0))
     scene = scene.with_geometry(np.rint(scene.points))
     assert whole_pixel_paths(scene, (64, 64, 1.0), budget=1.0) == (scene, 0)
+
+
+def test_paths_measured_together_are_rounded_as_if_measured_one_by_one():
+    """Thirty squares from faint to dark, some overlapping: batches share one render, yet each
+    square is rounded exactly when rounding it alone changes the picture by under the
+    tolerance."""
+    paths = []
+    for number in range(30):
+        grey = 1.0 - 0.03 * number
+        left = 6.3 + 19.0 * (number % 6) + (4.0 if number % 4 == 0 else 0.0)
+        top = 5.4 + 24.0 * (number // 6)
+        paths.append((square(left, top, 14.3 + 0.1 * number), FlatPaint((grey, grey, grey))))
+    scene = Scene.from_paths(128, 128, paths, background=(1.0, 1.0, 1.0))
+    whole = np.rint(scene.points)
+    picture = scene.render()
+    expected = []
+    for index in range(scene.path_count):
+        points = scene.points.copy()
+        start, end = scene.offsets[index], scene.offsets[index + 1]
+        points[start:end] = whole[start:end]
+        if np.mean((scene.with_geometry(points).render() - picture) ** 2) < IDLE_COST:
+            expected.append(index)
+    assert 0 < len(expected) < scene.path_count
+    rounded, count = whole_pixel_paths(scene, (128, 128, 1.0), budget=1.0)
+    changed = [
+        index
+        for index in range(scene.path_count)
+        if not np.array_equal(rounded.path_points(index), scene.path_points(index))
+    ]
+    assert changed == expected and count == len(expected)
