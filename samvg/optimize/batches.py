@@ -70,6 +70,25 @@ def disjoint_batches(windows: np.ndarray, width: int, height: int) -> np.ndarray
     return batches
 
 
+def packed_batches(windows: np.ndarray, width: int, height: int, cell: int = 4) -> np.ndarray:
+    """Each window's batch number, windows of one batch not meeting, in as few batches as
+    first fit finds with no order kept (a third as many as `disjoint_batches` on a painting's
+    islands). Occupancy is kept on a grid of ``cell``-pixel squares: a batch's grid is small
+    however many batches large overlapping windows need."""
+    cells = np.concatenate([windows[:, :2] // cell, -(-windows[:, 2:] // cell)], axis=1)
+    shape = (-(-height // cell), -(-width // cell))
+    occupied: list[np.ndarray] = []
+    batches = np.empty(len(windows), dtype=np.int64)
+    for number, (x0, y0, x1, y1) in enumerate(cells):
+        free = (batch for batch, grid in enumerate(occupied) if not grid[y0:y1, x0:x1].any())
+        batch = next(free, len(occupied))
+        if batch == len(occupied):
+            occupied.append(np.zeros(shape, dtype=bool))
+        occupied[batch][y0:y1, x0:x1] = True
+        batches[number] = batch
+    return batches
+
+
 def padded_windows(boxes: np.ndarray, pad: int, width: int, height: int) -> np.ndarray:
     """(N, 4) int: float ``boxes`` (x0, y0, x1, y1) grown to whole pixels and by ``pad`` each
     way, cut to the canvas (empty where a box lies off it)."""
@@ -84,7 +103,7 @@ def _first_changes(
 ) -> np.ndarray:
     """Each candidate's change of ``picture`` (``scene``'s render) by its edit alone."""
     changes = np.zeros(len(windows))
-    batches = disjoint_batches(windows, scene.width, scene.height)
+    batches = packed_batches(windows, scene.width, scene.height)
     for batch in range(int(batches.max(initial=-1)) + 1):
         members = np.flatnonzero(batches == batch)
         trial = _trial_picture(scene, picture, windows[members], edited(scene, members))
