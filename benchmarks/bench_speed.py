@@ -42,7 +42,17 @@ PATHS = REPO / "benchmarks/results/speed/paths"
 PLOTTED = ("samvg", "samvg-gradients", "diffvg", "live")
 PATHS_HEADING = "## Time against path count (median seconds per image)"
 PRESETS = ("default", "fast")
-STAGES = ("segment", "trace", "optimize", "reshape", "missing", "refine", "reduce", "finish")
+STAGES = (
+    "segment",
+    "trace",
+    "optimize",
+    "reshape",
+    "missing",
+    "refine",
+    "reduce",
+    "finish",
+    "texture",
+)
 
 
 def worker(image: str, preset: str) -> None:
