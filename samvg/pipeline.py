@@ -285,6 +285,8 @@ def _run_stages(
     simple = config.finish.finish_pass
     whole = simple and config.finish.whole_pixels
     _finish(scene, inputs.target, result, simple, _path_limit(config), whole)
+    if budget is not None:
+        _note_short_of(result, budget)
 
 
 def _finish_pass(
@@ -324,18 +326,21 @@ def _finish_pass(
 
 def _meet_budget(scene: Scene, inputs: _Inputs, budget: int, result: PipelineResult) -> Scene:
     """Paths the finish pass split off beyond the budget, and could not join into compound
-    paths (`_finish_pass`'s ``join_to``), are removed (least cost first); a scene short of the
-    budget says why."""
+    paths (`_finish_pass`'s ``join_to``), are removed (least cost first)."""
     if scene.element_count > budget:
         scene, removed = reduce_paths(scene, inputs.target, budget)
         result.counts["reduced"] = result.counts.get("reduced", 0) + removed
-    if scene.element_count < budget:
+    return scene
+
+
+def _note_short_of(result: PipelineResult, budget: int) -> None:
+    """A result short of the budget says why."""
+    if result.counts["paths"] < budget:
         result.notes.append(
-            f"{scene.element_count} paths, not {budget}: no further path lowers the error "
+            f"{result.counts['paths']} paths, not {budget}: no further path lowers the error "
             "measurably (or the finish pass merged touching paths of one colour, or made a path "
             "over the whole canvas the background)"
         )
-    return scene
 
 
 def _texture(
@@ -346,9 +351,10 @@ def _texture(
     result: PipelineResult,
     report: ProgressCallback,
 ) -> Scene:
-    """A textured image's texture layers (`add_texture_layers`): under a budget its last paths;
-    without one, on top of the paths, each kept only if it lowers the error by the ``--detail``
-    tolerance (as a round of stage 4 must)."""
+    """A textured image's texture layers (`add_texture_layers`): under a budget its last paths,
+    and where the budget still has room, more of them while each lowers the error by the
+    ``--detail`` tolerance; without a budget, on top of the paths, each kept only if it gains
+    that tolerance (as a round of stage 4 must)."""
     with _timed(result, "texture"):
         report("texture", 0, 1)
         settings = TextureSettings(seed=config.seed)
@@ -356,6 +362,12 @@ def _texture(
         room = budget if budget is not None else scene.element_count + settings.max_layers
         min_gain = 0.0 if budget is not None else config.missing.gain_tolerance
         scene, layers = add_texture_layers(scene, inputs.target, room, settings, opaque, min_gain)
+        free = 0 if budget is None else budget - scene.element_count
+        if budget is not None and free > 0 and layers == settings.layers(budget):
+            filling = replace(settings, share=1.0, max_layers=free)
+            gain = config.missing.gain_tolerance
+            scene, more = add_texture_layers(scene, inputs.target, budget, filling, opaque, gain)
+            layers += more
         report("texture", 1, 1)
     result.counts["texture_layers"] = layers
     if budget is not None and not settings.layers(budget):
