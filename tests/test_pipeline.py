@@ -313,7 +313,7 @@ def test_room_left_under_a_budget_goes_to_more_texture_layers_while_they_pay(
 ):
     """kodim03 at 256 paths wrote 144 (LPIPS 0.210 against VTracer's 0.201 at 258): the missing
     rounds found nothing more, and the texture layers stopped at their share of the budget. Here
-    the share is two layers, and the room beyond it takes more while each gains the tolerance."""
+    the share is two layers, and the room beyond it takes more while each lowers the error."""
     photo = read_image(bench_dir / "photo" / "kodim01.png")
     photo = np.asarray(Image.fromarray(photo).resize((192, 128), Image.Resampling.LANCZOS))
     base = {**QUICK, "checkpoint": str(sam_checkpoint), "paths": 200}
@@ -323,8 +323,7 @@ def test_room_left_under_a_budget_goes_to_more_texture_layers_while_they_pay(
     layered = samvg.run(photo, Config(**base))
     layers = layered.counts["texture_layers"]
     assert layers > 2 and layered.counts["paths"] == plain.counts["paths"] + layers < 200
-    gain = Config().missing.gain_tolerance
-    assert layered.mse < plain.mse * (1 - gain) ** (layers - 2)
+    assert layered.mse < plain.mse
     assert any(
         note.startswith(f"{layered.counts['paths']} paths, not 200") for note in layered.notes
     ), (layered.notes, layered.counts)
