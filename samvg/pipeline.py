@@ -363,9 +363,12 @@ def _texture(
         room = budget if budget is not None else scene.element_count + settings.max_layers
         min_gain = 0.0 if budget is not None else config.missing.gain_tolerance
         scene, layers = add_texture_layers(scene, inputs.target, room, settings, opaque, min_gain)
-        free = 0 if budget is None else budget - scene.element_count
-        if budget is not None and free > 0 and layers == settings.layers(budget):
-            filling = replace(settings, share=1.0, max_layers=free)
+        if (
+            budget is not None
+            and scene.element_count < budget
+            and layers == settings.layers(budget)
+        ):
+            filling = replace(settings, share=1.0, max_layers=budget - scene.element_count)
             scene, more = add_texture_layers(scene, inputs.target, budget, filling, opaque)
             layers += more
         report("texture", 1, 1)

@@ -33,7 +33,7 @@ def smallest_changes_in_batches(
     over the whole canvas. A callable ``budget`` (a full render, say) is called only when some
     candidate is under ``tolerance``."""
     picture = scene.render()
-    first = _first_changes(scene, picture, windows, edited)
+    first = changes_alone(scene, windows, edited, picture)
     order = np.argsort(first, kind="stable")
     order = order[first[order] < tolerance]
     if not len(order):
@@ -98,10 +98,13 @@ def padded_windows(boxes: np.ndarray, pad: int, width: int, height: int) -> np.n
     return np.concatenate([np.clip(low, 0, limits), np.clip(high, 0, limits)], axis=1)
 
 
-def _first_changes(
-    scene: Scene, picture: np.ndarray, windows: np.ndarray, edited: Edit
+def changes_alone(
+    scene: Scene, windows: np.ndarray, edited: Edit, picture: np.ndarray | None = None
 ) -> np.ndarray:
-    """Each candidate's change of ``picture`` (``scene``'s render) by its edit alone."""
+    """Each candidate's change of the render by its edit alone (``picture``: ``scene``'s render,
+    where known)."""
+    if picture is None:
+        picture = scene.render()
     changes = np.zeros(len(windows))
     batches = packed_batches(windows, scene.width, scene.height)
     for batch in range(int(batches.max(initial=-1)) + 1):

@@ -36,7 +36,7 @@ WINDOW_PAD = 2
 
 def removal_costs(scene: Scene, target: np.ndarray) -> np.ndarray:
     """For each path, how much the image's MSE rises when that path alone is removed (can be
-    negative: the path does harm), rendered on the path's window alone (see `window_change`)."""
+    negative: the path does harm), rendered on the path's window alone (`_path_window`)."""
     picture = scene.render()
     boxes = scene.path_boxes()
     kept = np.ones(scene.path_count, dtype=bool)
@@ -110,7 +110,7 @@ def _removal_cost(
     """How much the squared error against ``target`` (summed) rises when path ``index`` goes
     from the paths ``kept``, on its window; ``picture`` is the kept paths' whole render where
     known (else the window is rendered with the path as well)."""
-    found = _path_window(scene, boxes, kept, index, None)
+    found = _path_window(scene, boxes, kept, index)
     if found is None:
         return 0.0  # nothing of it on the canvas
     window, local, origin = found
@@ -130,19 +130,14 @@ def _without(window: Scene, local: int) -> Scene:
 
 
 def _path_window(
-    scene: Scene, boxes: np.ndarray, kept: np.ndarray, index: int, extra: np.ndarray | None
+    scene: Scene, boxes: np.ndarray, kept: np.ndarray, index: int
 ) -> tuple[Scene, int, np.ndarray] | None:
-    """Path ``index``'s window (its box, with the ``extra`` points', padded) as a scene of the
-    kept paths whose ``boxes`` reach into it, the path's index there and the window's origin;
-    None when none of it is on the canvas."""
-    low, high = boxes[index, :2], boxes[index, 2:]
-    if extra is not None:
-        low = np.minimum(low, extra.min(axis=0))
-        high = np.maximum(high, extra.max(axis=0))
-    x0, y0 = np.floor(low).astype(int) - WINDOW_PAD
-    x1, y1 = np.ceil(high).astype(int) + WINDOW_PAD
-    x0, y0 = max(x0, 0), max(y0, 0)
-    x1, y1 = min(x1, scene.width), min(y1, scene.height)
+    """Path ``index``'s window (its box, padded) as a scene of the kept paths whose ``boxes``
+    reach into it, the path's index there and the window's origin; None when none of it is on
+    the canvas."""
+    x0, y0, x1, y1 = padded_windows(
+        boxes[index : index + 1], WINDOW_PAD, scene.width, scene.height
+    )[0]
     if x1 <= x0 or y1 <= y0:
         return None
     touching = (
@@ -156,32 +151,6 @@ def _path_window(
     with_path = np.flatnonzero(touching)
     window = scene.subset(with_path).window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
     return window, int(np.searchsorted(with_path, index)), np.array([x0, y0], dtype=np.float64)
-
-
-def window_change(
-    scene: Scene,
-    boxes: np.ndarray,
-    kept: np.ndarray,
-    index: int,
-    replacement: np.ndarray | None = None,
-) -> float:
-    """The mean squared change of the picture (over the whole canvas) when path ``index`` goes
-    from the paths ``kept`` (a bool mask that holds it), or with ``replacement`` (its control
-    points, the same count) when it is redrawn there: rendered on the path's window alone (both
-    outlines' boxes, padded) from the kept paths whose ``boxes`` (`Scene.path_boxes`) reach
-    into it."""
-    found = _path_window(scene, boxes, kept, index, replacement)
-    if found is None:
-        return 0.0  # nothing of it on the canvas
-    window, local, origin = found
-    if replacement is None:
-        changed = _without(window, local)
-    else:
-        points = window.points.copy()
-        points[window.offsets[local] : window.offsets[local + 1]] = replacement - origin
-        changed = window.with_geometry(points)
-    squared = np.sum((window.render() - changed.render()) ** 2)
-    return float(squared) / (scene.width * scene.height * 3)
 
 
 def smallest_changes_first(
@@ -256,7 +225,7 @@ def _gradient_change(
 ) -> tuple[FlatPaint, float]:
     """Path ``index``'s best flat stand-in and the mean squared change of the picture it makes,
     measured on the path's window."""
-    found = _path_window(scene, boxes, kept, index, None)
+    found = _path_window(scene, boxes, kept, index)
     if found is None:
         return FlatPaint(scene.paints[index].rgba), 0.0
     window, local, _ = found
@@ -318,7 +287,7 @@ def remove_idle_paths(
     removed = smallest_changes_in_batches(
         scene,
         windows,
-        _collapsed,
+        collapsed_paths,
         tolerance,
         lambda: share * float(np.mean((scene.render() - target) ** 2)),
     )
@@ -329,7 +298,7 @@ def remove_idle_paths(
     return scene.subset(np.flatnonzero(kept)), len(removed)
 
 
-def _collapsed(scene: Scene, paths: np.ndarray) -> Scene:
+def collapsed_paths(scene: Scene, paths: np.ndarray) -> Scene:
     """``scene`` with ``paths`` drawn as nothing (each outline collapsed onto its first point:
     no area, so no pixel of it shows), the other paths keeping their indices."""
     if not len(paths):

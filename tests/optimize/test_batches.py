@@ -8,7 +8,7 @@ from samvg.optimize.batches import (
     padded_windows,
     smallest_changes_in_batches,
 )
-from samvg.optimize.reduce import IDLE_COST, WINDOW_PAD, smallest_changes_first, window_change
+from samvg.optimize.reduce import IDLE_COST, WINDOW_PAD, collapsed_paths, smallest_changes_first
 from samvg.scene import FlatPaint, Scene
 from tests.paths import square
 
@@ -61,34 +61,19 @@ def faint_squares() -> Scene:
 
 
 def test_removals_in_batches_equal_removals_one_by_one():
+    """The reference measures each change on whole-canvas renders, one path at a time."""
     scene = faint_squares()
-    boxes = scene.path_boxes()
-    kept = np.ones(scene.path_count, dtype=bool)
     one_by_one: list[int] = []
 
-    def remove(index: int) -> None:
-        kept[index] = False
-        one_by_one.append(index)
+    def whole_change(index: int) -> float:
+        current = collapsed_paths(scene, np.array(one_by_one, dtype=np.int64))
+        without = collapsed_paths(current, np.array([index]))
+        return float(np.mean((without.render() - current.render()) ** 2))
 
     budget = 40 * IDLE_COST
-    smallest_changes_first(
-        scene.path_count,
-        lambda index: window_change(scene, boxes, kept, index),
-        remove,
-        IDLE_COST,
-        budget,
-    )
-
-    def collapsed(current: Scene, paths: np.ndarray) -> Scene:
-        points = current.points.copy()
-        for index in paths:
-            points[current.offsets[index] : current.offsets[index + 1]] = points[
-                current.offsets[index]
-            ]
-        return current.with_geometry(points)
-
-    windows = padded_windows(boxes, WINDOW_PAD, scene.width, scene.height)
-    batched = smallest_changes_in_batches(scene, windows, collapsed, IDLE_COST, budget)
+    smallest_changes_first(scene.path_count, whole_change, one_by_one.append, IDLE_COST, budget)
+    windows = padded_windows(scene.path_boxes(), WINDOW_PAD, scene.width, scene.height)
+    batched = smallest_changes_in_batches(scene, windows, collapsed_paths, IDLE_COST, budget)
     assert 0 < len(one_by_one) < scene.path_count
     assert sorted(batched.tolist()) == sorted(one_by_one)
 

@@ -5,16 +5,18 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from samvg.optimize.batches import changes_alone, padded_windows
 from samvg.optimize.reduce import (
     IDLE_COST,
     IDLE_SHARE,
+    WINDOW_PAD,
     cheapest_together,
+    collapsed_paths,
     flatten_idle_gradients,
     reduce_paths,
     removal_costs,
     remove_idle_paths,
     smallest_changes_first,
-    window_change,
 )
 from samvg.scene import FlatPaint, LinearGradient, RadialGradient, Scene
 
@@ -81,10 +83,16 @@ def test_far_apart_paths_are_chosen_by_their_first_costs_alone():
     assert cheapest_together(scene, target, costs, 2) == list(np.argsort(costs, kind="stable")[:2])
 
 
+def removal_changes(scene: Scene) -> np.ndarray:
+    """Each path's removal change, measured on windows (as `remove_idle_paths` does)."""
+    windows = padded_windows(scene.path_boxes(), WINDOW_PAD, scene.width, scene.height)
+    return changes_alone(scene, windows, collapsed_paths)
+
+
 def test_window_changes_equal_whole_canvas_changes():
     scene, _ = scene_and_target()
-    kept, boxes, picture = np.ones(scene.path_count, dtype=bool), scene.path_boxes(), scene.render()
-    windowed = [window_change(scene, boxes, kept, index) for index in range(scene.path_count)]
+    picture = scene.render()
+    windowed = removal_changes(scene)
     whole = [
         np.mean((picture - scene.subset(np.flatnonzero(np.arange(4) != index)).render()) ** 2)
         for index in range(scene.path_count)
@@ -124,8 +132,7 @@ def test_many_faint_paths_stay_though_each_alone_is_under_the_tolerance():
     dots = [(square(8 * (k % 30) + 4, 8 * (k // 30) + 4, 2), FlatPaint(faint)) for k in range(60)]
     scene = Scene.from_paths(size, size, dots, background=grey)
     picture = scene.render()
-    kept, boxes = np.ones(scene.path_count, dtype=bool), scene.path_boxes()
-    changes = [window_change(scene, boxes, kept, index) for index in range(scene.path_count)]
+    changes = removal_changes(scene)
     assert min(changes) > 0 and max(changes) < IDLE_COST  # each dot alone is "idle"...
     assert remove_idle_paths(scene, picture, IDLE_COST)[1] == 0  # ...but together they show
     target = np.clip(picture + 0.02, 0, 1)  # a scene 4e-4 MSE off: 1 % of that buys a few dots
@@ -137,13 +144,17 @@ def test_many_faint_paths_stay_though_each_alone_is_under_the_tolerance():
 
 def test_window_change_of_a_redrawn_path_equals_the_whole_canvas_change():
     scene, _ = scene_and_target()
-    kept, boxes, picture = np.ones(scene.path_count, dtype=bool), scene.path_boxes(), scene.render()
+    picture = scene.render()
     for index in range(scene.path_count):
         moved = scene.path_points(index) + [1.4, -0.7]
         points = scene.points.copy()
         points[scene.offsets[index] : scene.offsets[index + 1]] = moved
-        whole = np.mean((scene.with_geometry(points).render() - picture) ** 2)
-        windowed = window_change(scene, boxes, kept, index, moved)
+        redrawn = scene.with_geometry(points)
+        whole = np.mean((redrawn.render() - picture) ** 2)
+        both = np.concatenate([scene.path_points(index), moved])
+        box = np.concatenate([both.min(axis=0), both.max(axis=0)])[None]
+        window = padded_windows(box, WINDOW_PAD, scene.width, scene.height)
+        windowed = changes_alone(scene, window, lambda current, _, redrawn=redrawn: redrawn)[0]
         assert np.isclose(windowed, whole, rtol=1e-5, atol=1e-9)
 
 
