@@ -15,7 +15,39 @@ def test_numbers_are_short_and_steps_relative():
         [[10.5, 20.25], [10.0, 19.75], [9.04, 20.0], [12.0, 20.0], [13.5, 21.0], [11.0, 22.0]]
     )
     # steps from (10.5, 20.25): (-.5, -.5) (-1.46, -.25) (1.5, -.25); then from (12, 20): ...
-    assert path_data(points, 2) == "M10.5 20.25c-.5-.5-1.46-.25 1.5-.25 1.5 1-1 2-1.5 .25z"
+    # no space before ".25": the number before already has its point
+    assert path_data(points, 2) == "M10.5 20.25c-.5-.5-1.46-.25 1.5-.25 1.5 1-1 2-1.5.25z"
+
+
+def test_straight_segments_are_lines_and_the_closing_one_is_z():
+    # a rectangle traced with controls on its edges (not at thirds), one corner doubled
+    corners = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [10.0, 10.0], [3.0, 7.0]])
+    rows = []
+    for a, b in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+        rows += [a, a + 0.2 * (b - a), a + 0.9 * (b - a)]
+    text = path_data(np.array(rows), 1)
+    assert text == "M0 0h10v10l-7-3z"
+    read = read_svg(
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="12" height="12"><path d="{text}"/></svg>'
+    ).paths[0][0]
+    # read back: the same corners, each joined to the next by a straight cubic
+    np.testing.assert_allclose(read[0::3], corners[[0, 1, 2, 4]], atol=1e-9)
+
+
+def test_a_path_of_no_length_keeps_one_segment_and_reads_back():
+    text = path_data(np.full((6, 2), 3.0), 1)
+    assert text == "M3 3h0z"
+    svg = f'<svg xmlns="http://www.w3.org/2000/svg" width="9" height="9"><path d="{text}"/></svg>'
+    assert read_svg(svg).paths[0][0].shape == (3, 2)
+
+
+def test_a_control_off_the_chord_keeps_the_cubic():
+    points = np.array([[0.0, 0.0], [3.0, 0.1], [7.0, 0.0], [10.0, 0.0], [10.0, 5.0], [0.0, 5.0]])
+    assert path_data(points, 1).startswith("M0 0c3 .1 7 0 10 0")
+    assert path_data(points, 0).startswith("M0 0h10")  # within half a unit once rounded
+    beyond = points.copy()
+    beyond[1] = (12.0, 0.0)  # on the chord's line but past its end: the curve overshoots
+    assert path_data(beyond, 0).startswith("M0 0c12 0 7 0 10 0")
 
 
 def test_precision_zero_writes_integers():
