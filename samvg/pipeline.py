@@ -32,7 +32,7 @@ from samvg.finish.outline import polygon_areas
 from samvg.finish.whole_pixels import ROUNDING_SHARE, whole_pixel_paths
 from samvg.imaging import alpha_channel, resize_longest, to_float_rgb, to_rgb_uint8
 from samvg.io import read_image_with_alpha
-from samvg.metrics.lpips import lpips_weights_path, read_lpips_state
+from samvg.metrics.lpips import load_lpips, lpips_distance, lpips_weights_path, read_lpips_state
 from samvg.missing import MissingSettings
 from samvg.missing.stage import MAX_AUTO_ROUNDS, add_missing_rounds, budget_pool
 from samvg.missing.texture import TextureSettings, add_texture_layers
@@ -280,7 +280,7 @@ def _run_stages(
         scene = _finish_pass(scene, config, inputs, result, report, join_to=budget)
     if budget is not None:
         scene = _meet_budget(scene, inputs, budget, result)
-    if config.missing.texture_layers and textured(inputs.target):
+    if _wants_texture(scene, inputs, budget, config):
         scene = _texture(scene, inputs, budget, config, result, report)
     simple = config.finish.finish_pass
     whole = simple and config.finish.whole_pixels
@@ -341,6 +341,20 @@ def _note_short_of(result: PipelineResult, budget: int) -> None:
             "measurably (or the finish pass merged touching paths of one colour, or made a path "
             "over the whole canvas the background)"
         )
+
+
+def _wants_texture(scene: Scene, inputs: _Inputs, budget: int | None, config: Config) -> bool:
+    """Texture layers go over a textured image; without a budget, also over one whose fitted
+    render still looks unlike it (`TextureSettings.min_lpips`): a pattern that stage 4's smooth
+    paths left out (a moon's craters, a wallpaper's stars)."""
+    if not config.missing.texture_layers:
+        return False
+    if textured(inputs.target):
+        return True
+    if budget is not None or not config.fit.wants_lpips:
+        return False
+    model = load_lpips(config.fit.lpips_weights, progress=False)
+    return lpips_distance(model, scene.render(), inputs.target) >= TextureSettings().min_lpips
 
 
 def _texture(

@@ -327,3 +327,26 @@ def test_room_left_under_a_budget_goes_to_more_texture_layers_while_they_pay(
     assert any(
         note.startswith(f"{layered.counts['paths']} paths, not 200") for note in layered.notes
     ), (layered.notes, layered.counts)
+
+
+def test_flat_art_gets_texture_layers_only_where_its_fit_still_looks_unlike_it(
+    bench_dir, lpips_weights
+):
+    """The gate of texture layers over an image that is not textured (JPEG complexity under
+    0.15): without a budget, its fitted render's LPIPS must be at least 0.05."""
+    from samvg.pipeline import _Inputs, _wants_texture
+    from samvg.scene import Frame, Scene
+
+    moon = read_image(bench_dir / "icon" / "tango_weather_clear_night.png")[..., :3]
+    target = moon.astype(np.float64) / 255.0
+    inputs = _Inputs(moon, target, None, Frame(*moon.shape[1::-1]))
+    flat = Scene(moon.shape[1], moon.shape[0], background=tuple(target.mean(axis=(0, 1))))
+    config = Config(lpips_weights=str(lpips_weights))
+    assert _wants_texture(flat, inputs, None, config)  # a grey square looks unlike a moon
+    assert not _wants_texture(flat, inputs, 64, config)  # under a budget: textured images only
+    assert not _wants_texture(flat, inputs, None, Config(use_lpips=False))
+    assert not _wants_texture(flat, inputs, None, Config(texture_layers=False))
+    # a render that looks like its target: no layers
+    render = flat.render()
+    alike = _Inputs((render * 255).round().astype(np.uint8), render, None, inputs.frame)
+    assert not _wants_texture(flat, alike, None, config)

@@ -52,6 +52,10 @@ class TextureSettings:
     and kodim04's 0.30 -> 0.33."""
     tolerance: float = 1.0
     """The tracer's tolerance (pixels) for an island's outline."""
+    min_lpips: float = 0.05
+    """Without a path budget, an image that is not textured (flat art) gets layers where its
+    fitted render's LPIPS against it is at least this: it still looks unlike it. Below, layers
+    cost bytes for differences hardly seen (see `benchmarks/results/detail.md`)."""
     seed: int = 0
 
     def layers(self, budget: int) -> int:
