@@ -11,6 +11,7 @@ import samvg
 import samvg.metrics.lpips as lpips_module
 from samvg import Config, InputError, WeightsError
 from samvg.errors import WeightsNotFoundError
+from samvg.imaging import to_float_rgb
 from samvg.io import read_image
 from samvg.missing.texture import TextureSettings
 from samvg.pipeline import check_resources
@@ -338,7 +339,7 @@ def test_flat_art_gets_texture_layers_only_where_its_fit_still_looks_unlike_it(
     from samvg.scene import Frame, Scene
 
     moon = read_image(bench_dir / "icon" / "tango_weather_clear_night.png")[..., :3]
-    target = moon.astype(np.float64) / 255.0
+    target = to_float_rgb(moon)
     inputs = _Inputs(moon, target, None, Frame(*moon.shape[1::-1]))
     flat = Scene(moon.shape[1], moon.shape[0], background=tuple(target.mean(axis=(0, 1))))
     config = Config(lpips_weights=str(lpips_weights))
