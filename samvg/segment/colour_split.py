@@ -110,7 +110,8 @@ def colour_parts(
     """The parts of ``mask`` (H, W) bool whose colour differs from the mask's main colour, as
     filled full-size masks, each followed by its own parts (``depth`` levels)."""
     depth = settings.depth if depth is None else depth
-    return _cluster_parts(mask, lab, settings, depth, with_main=False)
+    parts = _cluster_parts(_Region.of(mask), lab, settings, depth, with_main=False)
+    return [part.full(mask.shape) for part in parts]
 
 
 def colour_regions(
@@ -118,84 +119,95 @@ def colour_regions(
 ) -> list[np.ndarray]:
     """Every colour-coherent part of ``region`` (the main colour's too), each followed by its own
     parts: the candidate shapes of an area the current paths get wrong."""
-    return _cluster_parts(region, lab, settings, settings.depth, with_main=True)
+    parts = _cluster_parts(_Region.of(region), lab, settings, settings.depth, with_main=True)
+    return [part.full(region.shape) for part in parts]
 
 
 def _cluster_parts(
-    mask: np.ndarray, lab: np.ndarray, settings: ColourSplitSettings, depth: int, with_main: bool
-) -> list[np.ndarray]:
-    rows, cols = np.nonzero(mask)
+    region: _Region, lab: np.ndarray, settings: ColourSplitSettings, depth: int, with_main: bool
+) -> list[_Region]:
+    rows, cols = np.nonzero(region.window)
     if depth <= 0 or len(rows) == 0:
         return []
-    pixels = lab[rows, cols]
+    pixels = lab[rows + region.top, cols + region.left]
     centres = colour_clusters(pixels, settings)
     if centres is None:
         if not with_main:
             return []
         centres = pixels.mean(axis=0, keepdims=True)
     nearest = np.argmin(((pixels[:, None, :] - centres[None]) ** 2).sum(axis=2), axis=1)
-    top, left = rows.min(), cols.min()
-    window = np.full((rows.max() - top + 1, cols.max() - left + 1), -1, dtype=np.int16)
-    window[rows - top, cols - left] = nearest
+    window = np.full(region.window.shape, -1, dtype=np.int16)
+    window[rows, cols] = nearest
     parts: list[_Region] = []
 
-    def add(found: np.ndarray) -> None:
-        candidate = _Region.of(found)
-        if not any(candidate.same_as(other) for other in parts):
-            parts.append(candidate)
+    def add(found: _Region) -> None:
+        if not any(found.same_as(other) for other in parts):
+            parts.append(found)
 
     for cluster in range(0 if with_main else 1, len(centres)):
-        region = ndimage.binary_opening(window == cluster, _OPENING)
-        for part in filled_components(region, settings.min_pixels):
-            full = _full_size(part, mask.shape, top, left)
-            for found in (full, *_cluster_parts(full, lab, settings, depth - 1, False)):
-                add(found)
+        opened = ndimage.binary_opening(window == cluster, _OPENING)
+        for part in filled_components(opened, settings.min_pixels):
+            found = _Region.of(part, region.top, region.left)
+            for each in (found, *_cluster_parts(found, lab, settings, depth - 1, False)):
+                add(each)
     if not with_main and len(centres) > 1:
         # the main colour's own area may hold colours the first clustering had no room for
         # (a folder's stripes beside its blue front and dark border)
-        main = _full_size(ndimage.binary_opening(window == 0, _OPENING), mask.shape, top, left)
+        opened = ndimage.binary_opening(window == 0, _OPENING)
+        main = _Region.of(opened, region.top, region.left)
         for found in _cluster_parts(main, lab, settings, depth - 1, False):
             add(found)
-    return [part.mask for part in parts]
-
-
-def _full_size(part: np.ndarray, shape: tuple[int, ...], top: int, left: int) -> np.ndarray:
-    """``part``, a window whose corner is at (``top``, ``left``), as a mask of ``shape``."""
-    full = np.zeros(shape, dtype=bool)
-    full[top : top + part.shape[0], left : left + part.shape[1]] = part
-    return full
+    return parts
 
 
 @dataclass(frozen=True)
 class _Region:
-    """A full-size mask with its pixel count and bounds, so that comparing two stays cheap."""
+    """A mask as the window of its bounding box and that window's corner in the image: the
+    recursion works on windows, so that a small part costs as little as its size."""
 
-    mask: np.ndarray
+    window: np.ndarray
+    top: int
+    left: int
     count: int
-    rows: tuple[int, int]
-    cols: tuple[int, int]
 
     @classmethod
-    def of(cls, mask: np.ndarray) -> _Region:
+    def of(cls, mask: np.ndarray, top: int = 0, left: int = 0) -> _Region:
+        """The pixels of ``mask``, a window whose corner is at (``top``, ``left``)."""
         rows = np.flatnonzero(mask.any(axis=1))
         cols = np.flatnonzero(mask.any(axis=0))
         if len(rows) == 0:
-            return cls(mask, 0, (0, 0), (0, 0))
-        count = int(np.count_nonzero(mask))
-        bounds = (int(rows[0]), int(rows[-1]) + 1), (int(cols[0]), int(cols[-1]) + 1)
-        return cls(mask, count, *bounds)
+            return cls(np.zeros((0, 0), dtype=bool), top, left, 0)
+        window = mask[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]
+        count = int(np.count_nonzero(window))
+        return cls(window, top + int(rows[0]), left + int(cols[0]), count)
+
+    @property
+    def bottom(self) -> int:
+        return self.top + self.window.shape[0]
+
+    @property
+    def right(self) -> int:
+        return self.left + self.window.shape[1]
+
+    def full(self, shape: tuple[int, ...]) -> np.ndarray:
+        """The region as a mask of ``shape``."""
+        mask = np.zeros(shape, dtype=bool)
+        mask[self.top : self.bottom, self.left : self.right] = self.window
+        return mask
 
     def same_as(self, other: _Region, overlap: float = 0.9) -> bool:
-        """Whether the two masks cover nearly the same pixels (a disc found inside a ring's
+        """Whether the two regions cover nearly the same pixels (a disc found inside a ring's
         filled part and again as a region of its own colour): at least ``overlap`` of the
         larger one's pixels shared."""
         larger = max(self.count, other.count)
         if min(self.count, other.count) < overlap * larger:
             return False
-        top, bottom = max(self.rows[0], other.rows[0]), min(self.rows[1], other.rows[1])
-        left, right = max(self.cols[0], other.cols[0]), min(self.cols[1], other.cols[1])
+        top, bottom = max(self.top, other.top), min(self.bottom, other.bottom)
+        left, right = max(self.left, other.left), min(self.right, other.right)
         if top >= bottom or left >= right:
             return larger == 0
-        window = (slice(top, bottom), slice(left, right))
-        shared = np.count_nonzero(self.mask[window] & other.mask[window])
-        return bool(shared >= overlap * larger)
+        mine = self.window[top - self.top : bottom - self.top, left - self.left : right - self.left]
+        theirs = other.window[
+            top - other.top : bottom - other.top, left - other.left : right - other.left
+        ]
+        return bool(np.count_nonzero(mine & theirs) >= overlap * larger)

@@ -59,6 +59,26 @@ def test_a_ring_part_is_split_again_for_what_it_encloses() -> None:
     assert abs(sizes[0] - np.count_nonzero(radius < 10)) < 20  # the disc it holds
 
 
+def test_a_mask_moved_on_the_canvas_gives_the_same_parts_moved() -> None:
+    def ringed(top: int, left: int) -> tuple[np.ndarray, np.ndarray]:
+        image = _image(96)
+        yy, xx = np.mgrid[:96, :96]
+        radius = np.hypot(yy - top - 30, xx - left - 30)
+        image[radius < 30] = WHITE
+        image[(radius < 20) & (radius >= 10)] = RED
+        image[radius < 10] = BLUE
+        return radius < 30, image
+
+    corner_mask, corner_image = ringed(0, 0)
+    moved_mask, moved_image = ringed(33, 21)
+    at_corner = colour_parts(corner_mask, lab_image(corner_image), SETTINGS)
+    moved = colour_parts(moved_mask, lab_image(moved_image), SETTINGS)
+    assert len(at_corner) == len(moved) == 2
+    for part, moved_part in zip(at_corner, moved, strict=True):
+        assert part.shape == moved_part.shape == (96, 96)
+        assert np.array_equal(np.roll(part, (33, 21), axis=(0, 1)), moved_part)
+
+
 def test_anti_aliased_seams_and_specks_make_no_parts() -> None:
     image = _image()
     mask = np.zeros((64, 64), dtype=bool)
