@@ -525,7 +525,7 @@ def _add_vectorize_command(commands: Any) -> None:
         default="default",
         help="default: segments per outline, opaque fills, finish pass; paper: the paper's "
         "exact procedure (32x32 grid with crops, 5 segments, learned opacity, no finish pass); "
-        "fast: the default with an 8x8 grid, at 384 px, 120 steps a phase, no LPIPS",
+        "fast: the default with an 8x8 grid, at 384 px, 120 steps a phase (60 a draft), no LPIPS",
     )
     vectorize.add_argument("--fast", action="store_true", help="same as --preset fast")
     _add_tuning_options(vectorize)

@@ -415,7 +415,7 @@ class Config:
     @classmethod
     def fast(cls, **overrides: Any) -> Config:
         """The quick preset: the default with an 8x8 grid, 384-px working size, 120 steps a
-        phase and MSE only."""
+        phase (60 for the drafts) and MSE only."""
         return cls(**{**FAST, **overrides})
 
     def replace(self, **changes: Any) -> Config:
@@ -462,6 +462,7 @@ FAST: dict[str, Any] = {
     "points_per_side": 8,
     "size": 384,
     "iterations": 120,
+    "draft_iterations": 60,
     "use_lpips": False,
     "texture_layers": False,
 }
