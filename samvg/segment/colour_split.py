@@ -2,10 +2,8 @@
 a suit symbol on a card) gets one part per extra colour, to be painted on top of it, so that no
 path is filled with the blur of two colours.
 
-The colours are found by k-means in CIELAB (SciPy's ``kmeans2`` with k-means++ seeding: the
-masks of an image are clustered hundreds of times, and scikit-learn's ``KMeans`` takes some 3 ms
-a call, mostly set-up, where ``kmeans2`` takes under 1) on a sample of the mask's pixels; k
-grows while each step still removes a large share of the colour variance and the
+The colours are found by k-means in CIELAB (scikit-learn ``KMeans``) on a sample of the mask's
+pixels; k grows while each step still removes a large share of the colour variance and the
 centres stay distinct: ``contrast`` apart (in ΔE), or, for two flat colours, only
 ``fine_contrast`` apart (a folder's grey stripes, ΔE 7: distinct to the eye, but a smooth ramp
 of that range must stay one colour for a gradient fill; the two are told apart by how rare the
@@ -22,16 +20,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
-from scipy.cluster.vq import ClusterError, kmeans2
 from skimage.color import rgb2lab
+from sklearn.cluster import KMeans
 
 from samvg.imaging import filled_components
 
 #: k-means runs on at most this many of a mask's pixels (labels are then given to all).
 SAMPLE_PIXELS = 4000
-#: Lloyd steps of each k-means run, and runs from different seeds (the best is kept).
-KMEANS_STEPS = 20
-KMEANS_RUNS = 2
 #: k grows while the next centre removes at least this share of the remaining colour variance.
 MIN_VARIANCE_DROP = 0.4
 #: Two clusters closer than ``contrast`` are two colours only when the colours halfway between
@@ -76,36 +71,15 @@ def colour_clusters(pixels: np.ndarray, settings: ColourSplitSettings) -> np.nda
     inertia = spread * len(sample)
     distinct = len(np.unique(np.round(sample, 1), axis=0))
     for k in range(2, min(settings.max_colours, distinct) + 1):
-        fitted = _kmeans(sample, k, rng)
-        if fitted is None:
-            break
-        centres, labels, fitted_inertia = fitted
+        kmeans = KMeans(n_clusters=k, n_init=2, random_state=settings.seed).fit(sample)
+        centres = kmeans.cluster_centers_
         if (
             not _distinct(sample, centres, settings)
-            or fitted_inertia > (1 - MIN_VARIANCE_DROP) * inertia
+            or kmeans.inertia_ > (1 - MIN_VARIANCE_DROP) * inertia
         ):
             break
-        counts = np.bincount(labels, minlength=k)
-        best, inertia = centres[np.argsort(-counts, kind="stable")], fitted_inertia
-    return best
-
-
-def _kmeans(
-    sample: np.ndarray, k: int, rng: np.random.Generator
-) -> tuple[np.ndarray, np.ndarray, float] | None:
-    """k-means of ``sample``, the best of `KMEANS_RUNS`: centres (k, 3), each pixel's cluster
-    and the summed squared distances; None when every run ends with an empty cluster."""
-    best: tuple[np.ndarray, np.ndarray, float] | None = None
-    for _ in range(KMEANS_RUNS):
-        try:
-            centres, labels = kmeans2(
-                sample, k, iter=KMEANS_STEPS, minit="++", seed=rng, missing="raise"
-            )
-        except ClusterError:
-            continue
-        inertia = float(((sample - centres[labels]) ** 2).sum())
-        if best is None or inertia < best[2]:
-            best = centres, labels, inertia
+        counts = np.bincount(kmeans.labels_, minlength=k)
+        best, inertia = centres[np.argsort(-counts, kind="stable")], kmeans.inertia_
     return best
 
 
