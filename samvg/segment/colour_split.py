@@ -136,8 +136,8 @@ def _cluster_parts(
             return []
         centres = pixels.mean(axis=0, keepdims=True)
     nearest = np.argmin(((pixels[:, None, :] - centres[None]) ** 2).sum(axis=2), axis=1)
-    window = np.full(region.window.shape, -1, dtype=np.int16)
-    window[rows, cols] = nearest
+    labels = np.full(region.window.shape, -1, dtype=np.int16)  # each pixel's nearest centre
+    labels[rows, cols] = nearest
     parts: list[_Region] = []
 
     def add(found: _Region) -> None:
@@ -145,7 +145,7 @@ def _cluster_parts(
             parts.append(found)
 
     for cluster in range(0 if with_main else 1, len(centres)):
-        opened = ndimage.binary_opening(window == cluster, _OPENING)
+        opened = ndimage.binary_opening(labels == cluster, _OPENING)
         for part in filled_components(opened, settings.min_pixels):
             found = _Region.of(part, region.top, region.left)
             for each in (found, *_cluster_parts(found, lab, settings, depth - 1, False)):
@@ -153,7 +153,7 @@ def _cluster_parts(
     if not with_main and len(centres) > 1:
         # the main colour's own area may hold colours the first clustering had no room for
         # (a folder's stripes beside its blue front and dark border)
-        opened = ndimage.binary_opening(window == 0, _OPENING)
+        opened = ndimage.binary_opening(labels == 0, _OPENING)
         main = _Region.of(opened, region.top, region.left)
         for found in _cluster_parts(main, lab, settings, depth - 1, False):
             add(found)
