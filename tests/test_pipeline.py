@@ -11,7 +11,7 @@ import samvg
 import samvg.metrics.lpips as lpips_module
 from samvg import Config, InputError, WeightsError
 from samvg.errors import WeightsNotFoundError
-from samvg.imaging import to_float_rgb
+from samvg.imaging import to_float_rgb, to_rgb_uint8
 from samvg.io import read_image
 from samvg.missing.texture import TextureSettings
 from samvg.pipeline import check_resources
@@ -349,5 +349,5 @@ def test_flat_art_gets_texture_layers_only_where_its_fit_still_looks_unlike_it(
     assert not _wants_texture(flat, inputs, None, Config(texture_layers=False))
     # a render that looks like its target: no layers
     render = flat.render()
-    alike = _Inputs((render * 255).round().astype(np.uint8), render, None, inputs.frame)
+    alike = _Inputs(to_rgb_uint8(render), render, None, inputs.frame)
     assert not _wants_texture(flat, alike, None, config)
